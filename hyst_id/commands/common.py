@@ -1,0 +1,117 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""Arguments shared by the subcommands: reading a recording, GAASS settings, domains."""
+
+from __future__ import annotations
+
+import argparse
+
+import yaml
+
+from hyst_id.chains import CHAIN_NAMES, ChainSpec, chain_spec
+from hyst_id.errors import ConfigError
+from hyst_id.identify import IdentifySettings
+from hyst_id.io.recording import Recording
+
+__all__ = ['add_recording_arguments', 'add_settings_arguments', 'load_recording',
+           'make_spec', 'make_settings']
+
+
+def add_recording_arguments(parser: argparse.ArgumentParser) -> None:
+    """Arguments naming a recording and how to read it."""
+    parser.add_argument('recording', help='rosbag2 MCAP (directory or .mcap file) or CSV')
+    parser.add_argument('--channel', choices=tuple(CHAIN_NAMES), default='position',
+                        help='measured channel (default: position)')
+    parser.add_argument('--params', metavar='YAML',
+                        help='params file: topics/fields for bags, domains, GAASS settings')
+    parser.add_argument('--columns', metavar='T,CMD,MEAS', default=None,
+                        help='CSV columns by name or 0-based index (default t,command,'
+                        'measurement)')
+    parser.add_argument('--time-scale', type=float, default=None,
+                        help='multiply the CSV time column by this to get seconds')
+    parser.add_argument('--quiet', action='store_true', help='no progress bar')
+
+
+def add_settings_arguments(parser: argparse.ArgumentParser) -> None:
+    """GAASS and refinement settings (paper's defaults)."""
+    g = parser.add_argument_group('GAASS (defaults: the paper)')
+    g.add_argument('--seeds', type=int, default=10, help='number of seeds (0..N-1)')
+    g.add_argument('--seed-offset', type=int, default=0, help='first seed')
+    g.add_argument('--pop-size', type=int, default=10)
+    g.add_argument('--generations', type=int, default=500)
+    g.add_argument('--c', type=float, default=0.007, help='search-space contraction rate')
+    g.add_argument('--xi', type=float, default=0.02, help='mutation subspace coefficient')
+    g.add_argument('--er-bound', type=float, default=None,
+                   help='stop a run once %%e_r falls below this')
+    g.add_argument('--workers', type=int, default=0, help='processes (0: one per core)')
+    g.add_argument('--gaass-only', action='store_true',
+                   help='no refinement after GAASS (fidelity to the paper)')
+    g.add_argument('--domains', default='auto', metavar='auto|paper|YAML',
+                   help='search domains: derived from the data (auto), the paper\'s '
+                   'preset, or a YAML mapping name: [low, high]')
+
+
+def load_recording(args: argparse.Namespace) -> Recording:
+    """Read and validate the recording named on the command line."""
+    from hyst_id.io.readers import load_topic_config, read_recording
+
+    topics = load_topic_config(args.params, args.channel) if args.params else None
+    columns = None
+    if args.columns:
+        parts = [c.strip() for c in args.columns.split(',')]
+        if len(parts) != 3:
+            raise ConfigError('--columns needs three entries: time, command, measurement')
+        columns = tuple(int(c) if c.lstrip('-').isdigit() else c for c in parts)
+    return read_recording(args.recording, args.channel, topics=topics, columns=columns,
+                          time_scale=args.time_scale)
+
+
+def make_settings(args: argparse.Namespace) -> IdentifySettings:
+    """GAASS settings from the command line."""
+    if args.seeds < 1 or args.pop_size < 2 or args.generations < 1:
+        raise ConfigError('need --seeds >= 1, --pop-size >= 2 and --generations >= 1')
+    return IdentifySettings(
+        pop_size=args.pop_size, maxiter=args.generations, c=args.c, xi=args.xi,
+        seeds=tuple(range(args.seed_offset, args.seed_offset + args.seeds)),
+        workers=args.workers, refine=not args.gaass_only, er_bound_percent=args.er_bound)
+
+
+def make_spec(args: argparse.Namespace, rec: Recording) -> ChainSpec:
+    """Chain spec with the search domains asked for."""
+    choice = args.domains
+    if choice == 'paper':
+        return chain_spec(rec.channel)
+    if choice == 'auto':
+        try:
+            from hyst_id.domains import domains_from_data
+        except ModuleNotFoundError:
+            return chain_spec(rec.channel)
+        return domains_from_data(rec)
+    try:
+        with open(choice) as f:
+            data = yaml.safe_load(f) or {}
+    except OSError as exc:
+        raise ConfigError(f'cannot read domains file {choice}: {exc.strerror}') from None
+    except yaml.YAMLError as exc:
+        raise ConfigError(f'domains file {choice} is not valid YAML: '
+                          f'{str(exc).splitlines()[0]}') from None
+    data = data.get('domains', data)
+    if not isinstance(data, dict):
+        raise ConfigError(f'domains file {choice} must map parameter names to [low, high]')
+    try:
+        domains = {str(k): (float(v[0]), float(v[1])) for k, v in data.items()}
+    except (TypeError, ValueError, IndexError):
+        raise ConfigError(f'domains file {choice}: each entry must be [low, high]') from None
+    return chain_spec(rec.channel, domains=domains)

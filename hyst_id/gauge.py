@@ -1,0 +1,111 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""Gauge freedom of the chain and its canonical form.
+
+``H -> B -> sensor -> (k, b)`` is over-parameterised: the signal between H
+and B can be scaled by any ``alpha > 0`` and shifted by any ``delta`` (H's
+output lines absorb it, B's slope and crossings undo it), and the same
+holds between B and the affine calibration. Different parameter vectors on
+one such *gauge orbit* give bit-for-bit the same chain output, so raw
+optimiser results are not comparable (or averageable) across seeds.
+
+The canonical form used for every report, average and compensator:
+
+* backlash with unit slope, centred on zero: ``m_bl = 1``,
+  ``c_bl = -w``, ``c_br = +w`` (``w`` = half the dead band);
+* calibration ``k = 1, b = 0``: the hysteresis output is expressed directly
+  in the measurement's units.
+
+Sensor dynamics have unit DC gain, so they commute with the affine map.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ['affine_map_output', 'canonical_gauge']
+
+
+def affine_map_output(params: np.ndarray, alpha: float, delta: float) -> np.ndarray:
+    """Re-express the chain with its H/B output replaced by ``alpha * out + delta``.
+
+    Parameters
+    ----------
+    params : numpy.ndarray
+        Chain parameters (hysteresis 8, backlash 3, then sensor parameters).
+    alpha : float
+        Positive scale applied after the backlash.
+    delta : float
+        Offset applied after the scale.
+
+    Returns
+    -------
+    numpy.ndarray
+        Parameters whose chain output equals ``alpha * old_output + delta``.
+    """
+    if not alpha > 0:
+        raise ValueError('alpha must be positive')
+    p = np.array(params, dtype=np.float64)
+    m_bl = p[8]
+    # alpha*m_bl*(u - c) + delta = m_bl*(u' - c') with u' = alpha*u + delta/m_bl
+    # and c' = alpha*c: the map moves into H's lines and B's crossings.
+    p[0:4] *= alpha                      # slopes of H
+    p[4] -= delta / (m_bl * p[0])        # c_l: u' = m_l' (v - c_l'), offset delta/m_bl
+    p[5] -= delta / (m_bl * p[1])        # c_r
+    p[6] = alpha * p[6] + delta / m_bl   # c_t
+    p[7] = alpha * p[7] + delta / m_bl   # c_b
+    p[9] *= alpha                        # c_bl
+    p[10] *= alpha                       # c_br
+    return p
+
+
+def canonical_gauge(params: np.ndarray, calibration: tuple[float, float] = (1.0, 0.0)
+                    ) -> np.ndarray:
+    """Return the canonical representative of a parameter vector's gauge orbit.
+
+    Parameters
+    ----------
+    params : numpy.ndarray
+        Chain parameters in search space.
+    calibration : tuple of float
+        ``(k, b)`` applied after the sensor. ``k`` must be positive: a
+        negative gain mirrors the loop, which no positive-slope H represents.
+
+    Returns
+    -------
+    numpy.ndarray
+        Equivalent parameters with ``m_bl = 1``, backlash centred on 0, and
+        output in measurement units (calibration ``(1, 0)``).
+    """
+    k, b = calibration
+    if not k > 0:
+        raise ValueError('calibration gain must be positive for a canonical form')
+    p = np.array(params, dtype=np.float64)
+    m_bl, c_bl, c_br = p[8], p[9], p[10]
+    # B output y = m_bl (u - c); write it as y = (u' - c') with u' = m_bl u.
+    p[0:4] *= m_bl
+    p[6] *= m_bl
+    p[7] *= m_bl
+    p[8], p[9], p[10] = 1.0, m_bl * c_bl, m_bl * c_br
+    # Centre the backlash: shift u' and c' by -centre (output unchanged).
+    centre = 0.5 * (p[9] + p[10])
+    p[6] -= centre
+    p[7] -= centre
+    p[4] += centre / p[0]
+    p[5] += centre / p[1]
+    p[9] -= centre
+    p[10] -= centre
+    # Calibration: y_meas = k y + b; fold into H's output (B has unit slope).
+    return affine_map_output(p, k, b)

@@ -1,0 +1,269 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""Identification of a chain from a recording: GAASS over seeds, refinement, noise floor.
+
+``identify(recording)`` runs GAASS once per seed (in parallel processes),
+optionally polishes each best chromosome with a bounded local least-squares
+fit (:mod:`hyst_id.refine`), brings every result into the canonical gauge
+(:mod:`hyst_id.gauge`) so seeds can be compared and averaged, and returns an
+:class:`Identification` holding all of it, the paper's %e_r (Eq. 7) and the
+noise floor.
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import os
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import asdict, dataclass, field
+from typing import Callable
+
+import numpy as np
+
+from hyst_id.chains import ChainSpec, chain_spec, er_percent
+from hyst_id.errors import IdentificationError, InvalidParametersError
+from hyst_id.gaass import GaassSolver
+from hyst_id.gauge import canonical_gauge
+from hyst_id.io.recording import Recording, validate_recording
+from hyst_id.noise import noise_floor_percent
+from hyst_id.refine import refine
+
+__all__ = ['IdentifySettings', 'SeedRun', 'Identification', 'identify', 'run_seed']
+
+
+@dataclass(frozen=True)
+class IdentifySettings:
+    """How to identify; defaults are the paper's GAASS settings plus refinement.
+
+    Attributes
+    ----------
+    pop_size, maxiter, c, xi :
+        GAASS population size, generations, contraction rate (Eq. 15) and
+        mutation subspace coefficient (Eq. 22).
+    seeds : tuple of int
+        One GAASS run per seed; results are averaged like the paper's Table 1.
+    workers : int
+        Parallel processes (0: one per core, at most one per seed).
+    refine : bool
+        Polish each GAASS result with bounded least squares (GAASS-only when False).
+    refine_max_nfev : int
+        Cost evaluations allowed to the refinement of one seed.
+    er_bound_percent : float or None
+        Stop a GAASS run early once %e_r falls below this bound.
+    """
+
+    pop_size: int = 10
+    maxiter: int = 500
+    c: float = 0.007
+    xi: float = 0.02
+    seeds: tuple[int, ...] = tuple(range(10))
+    workers: int = 0
+    refine: bool = True
+    refine_max_nfev: int = 4000
+    er_bound_percent: float | None = None
+
+
+@dataclass
+class SeedRun:
+    """Result of one seed: GAASS, then (optionally) refinement, raw and canonical."""
+
+    seed: int
+    x_raw: np.ndarray
+    x: np.ndarray
+    fun: float
+    er_percent: float
+    er_gaass_percent: float
+    nfev: int
+    nit: int
+    best_history: np.ndarray
+    message: str
+
+
+@dataclass
+class Identification:
+    """Everything an identification produced.
+
+    Attributes
+    ----------
+    channel : str
+        Channel of the chain.
+    names : tuple of str
+        Parameter names.
+    params : dict
+        Best run's parameters in the canonical gauge (output in measurement units).
+    params_mean : dict
+        Canonical parameters averaged over seeds (the paper's Table 1 convention).
+    er_percent : float
+        %e_r of the best run.
+    er_mean_params_percent : float
+        %e_r of the averaged parameters.
+    noise_floor_percent : float
+        %e_r that the estimated measurement noise alone gives.
+    runs : list of SeedRun
+        Per-seed results.
+    bounds : numpy.ndarray
+        Search domains used.
+    """
+
+    channel: str
+    names: tuple[str, ...]
+    params: dict
+    params_mean: dict
+    er_percent: float
+    er_mean_params_percent: float
+    noise_floor_percent: float
+    runs: list[SeedRun]
+    bounds: np.ndarray
+    domain_source: str
+    settings: IdentifySettings
+    warnings: list[str] = field(default_factory=list)
+    source: str = ''
+
+    @property
+    def x(self) -> np.ndarray:
+        """Best canonical parameter vector."""
+        return np.array([self.params[n] for n in self.names])
+
+    def spec(self) -> ChainSpec:
+        """Chain spec that simulates the canonical parameters (calibration 1, 0)."""
+        return chain_spec(self.channel, calibration=(1.0, 0.0)).with_bounds(
+            self.bounds, source=self.domain_source)
+
+    def to_dict(self) -> dict:
+        """JSON-ready summary (arrays as lists)."""
+        runs = []
+        for r in self.runs:
+            runs.append({'seed': r.seed, 'params': dict(zip(self.names, r.x.tolist())),
+                         'er_percent': r.er_percent, 'er_gaass_percent': r.er_gaass_percent,
+                         'nfev': r.nfev, 'nit': r.nit, 'message': r.message})
+        return {
+            'channel': self.channel, 'source': self.source,
+            'params': self.params, 'params_mean': self.params_mean,
+            'calibration': {'k': 1.0, 'b': 0.0, 'note': 'canonical gauge: output in '
+                            'measurement units, backlash unit slope centred on 0'},
+            'er_percent': self.er_percent,
+            'er_mean_params_percent': self.er_mean_params_percent,
+            'er_seeds_percent': [r.er_percent for r in self.runs],
+            'noise_floor_percent': self.noise_floor_percent,
+            'domains': {n: list(map(float, b)) for n, b in zip(self.names, self.bounds)},
+            'domain_source': self.domain_source,
+            'settings': {k: (list(v) if isinstance(v, tuple) else v)
+                         for k, v in asdict(self.settings).items()},
+            'warnings': list(self.warnings), 'runs': runs,
+        }
+
+
+def run_seed(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray, measurement: np.ndarray,
+             settings: IdentifySettings, seed: int) -> SeedRun:
+    """Run GAASS (and refinement) for one seed; picklable for worker processes."""
+    cost = spec.cost_function(t_s, command, measurement)
+    target = None
+    if settings.er_bound_percent is not None:
+        target = (settings.er_bound_percent / 100.0) ** 2 * float(np.sum(measurement ** 2))
+    solver = GaassSolver(cost, spec.bounds, feasible=spec.feasible, pop_size=settings.pop_size,
+                         maxiter=settings.maxiter, c=settings.c, xi=settings.xi,
+                         target=target, rng=seed)
+    res = solver.solve()
+    x_raw, fun, nfev = np.asarray(res.x, dtype=float), float(res.fun), int(res.nfev)
+    er_ga = float(er_percent(fun, measurement))
+    if settings.refine:
+        x_ref, fun_ref, nfev_ref = refine(spec, x_raw, t_s, command, measurement,
+                                          max_nfev=settings.refine_max_nfev)
+        nfev += nfev_ref
+        if fun_ref < fun:
+            x_raw, fun = x_ref, fun_ref
+    k, b = spec.fit_calibration(x_raw, t_s, command, measurement)
+    if k > 0:
+        x = canonical_gauge(x_raw, (k, b))
+    else:
+        x = x_raw.copy()
+    return SeedRun(seed=int(seed), x_raw=x_raw, x=x, fun=fun,
+                   er_percent=float(er_percent(fun, measurement)), er_gaass_percent=er_ga,
+                   nfev=nfev, nit=int(res.nit),
+                   best_history=np.asarray(res.history.best_fun, dtype=float),
+                   message=str(res.message))
+
+
+def _n_workers(settings: IdentifySettings) -> int:
+    workers = settings.workers or (os.cpu_count() or 1)
+    return max(1, min(workers, len(settings.seeds)))
+
+
+def identify(recording: Recording, *, spec: ChainSpec | None = None,
+             settings: IdentifySettings | None = None,
+             progress: Callable[[int, int, SeedRun], None] | None = None) -> Identification:
+    """Identify the chain of ``recording.channel`` from a recording.
+
+    Parameters
+    ----------
+    recording : Recording
+        The run to identify from (validated here).
+    spec : ChainSpec, optional
+        Chain spec with search domains; default the paper's domains.
+    settings : IdentifySettings, optional
+        GAASS and refinement settings; default the paper's.
+    progress : callable, optional
+        Called as ``progress(done, total, seed_run)`` after each seed.
+
+    Returns
+    -------
+    Identification
+    """
+    rec = validate_recording(recording)
+    settings = settings or IdentifySettings()
+    spec = spec or chain_spec(rec.channel)
+    if spec.channel != rec.channel:
+        raise IdentificationError(
+            f'chain is for {spec.channel!r} but the recording is {rec.channel!r}')
+    if not settings.seeds:
+        raise IdentificationError('no seeds given')
+    args = (spec, rec.t_s, rec.command, rec.measurement, settings)
+    runs: list[SeedRun] = []
+    n_workers = _n_workers(settings)
+    if n_workers == 1:
+        for seed in settings.seeds:
+            runs.append(run_seed(*args, seed))
+            if progress:
+                progress(len(runs), len(settings.seeds), runs[-1])
+    else:
+        ctx = multiprocessing.get_context('spawn')
+        with ProcessPoolExecutor(max_workers=n_workers, mp_context=ctx) as pool:
+            futures = [pool.submit(run_seed, *args, seed) for seed in settings.seeds]
+            for fut in futures:
+                runs.append(fut.result())
+                if progress:
+                    progress(len(runs), len(settings.seeds), runs[-1])
+    return summarise(rec, spec, settings, runs)
+
+
+def summarise(rec: Recording, spec: ChainSpec, settings: IdentifySettings,
+              runs: list[SeedRun]) -> Identification:
+    """Combine seed runs into an :class:`Identification`."""
+    best = min(runs, key=lambda r: r.fun)
+    canon = chain_spec(rec.channel, calibration=(1.0, 0.0))
+    xs = np.array([r.x for r in runs])
+    x_mean = xs.mean(axis=0)
+    try:
+        y_mean = canon.simulate(x_mean, rec.t_s, rec.command)
+        er_mean = float(er_percent(np.sum((rec.measurement - y_mean) ** 2), rec.measurement))
+    except InvalidParametersError:  # an average of feasible sets can be infeasible
+        er_mean = float('nan')
+    return Identification(
+        channel=rec.channel, names=spec.names, params=spec.as_dict(best.x),
+        params_mean=spec.as_dict(x_mean), er_percent=best.er_percent,
+        er_mean_params_percent=er_mean,
+        noise_floor_percent=noise_floor_percent(rec.measurement),
+        runs=runs, bounds=spec.bounds, domain_source=spec.domain_source,
+        settings=settings, source=rec.source)

@@ -1,0 +1,223 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""The :class:`Recording` value object and its validation.
+
+A recording is one command/response run: sample times in seconds, the
+command applied to the actuator and one measured channel. Readers for CSV
+and rosbag2 MCAP files live in :mod:`hyst_id.io.readers`; everything they
+return passes through :func:`validate_recording` once, here.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from hyst_id.errors import NoExcitationError, RecordingError
+
+__all__ = [
+    'CHANNELS',
+    'Recording',
+    'count_reversals',
+    'validate_recording',
+]
+
+#: Measured channels the chains know about.
+CHANNELS = ('position', 'pressure', 'flow')
+
+#: Fewest samples an identification can work with.
+MIN_SAMPLES = 20
+
+
+@dataclass(frozen=True)
+class Recording:
+    """One command/response run.
+
+    Attributes
+    ----------
+    t_s : numpy.ndarray
+        Sample times in seconds, strictly increasing.
+    command : numpy.ndarray
+        Command applied to the actuator at each sample (held until the
+        next sample), in ``command_unit`` (mA on the paper's rig).
+    measurement : numpy.ndarray
+        The measured channel at each sample, in ``measurement_unit``.
+    channel : str
+        One of :data:`CHANNELS`.
+    command_unit, measurement_unit : str
+        Free-text units, for reports only.
+    source : str
+        Where the data came from (path, topic names), for reports only.
+    """
+
+    t_s: np.ndarray
+    command: np.ndarray
+    measurement: np.ndarray
+    channel: str = 'position'
+    command_unit: str = ''
+    measurement_unit: str = ''
+    source: str = ''
+    notes: tuple = field(default=())
+
+    @property
+    def n_samples(self) -> int:
+        """Number of samples."""
+        return int(self.t_s.shape[0])
+
+    @property
+    def duration_s(self) -> float:
+        """Time from the first to the last sample, in seconds."""
+        return float(self.t_s[-1] - self.t_s[0])
+
+    @property
+    def dt_s(self) -> np.ndarray:
+        """Sample intervals in seconds, ``dt_s[0]`` repeated first (length n)."""
+        d = np.diff(self.t_s)
+        return np.concatenate([d[:1], d])
+
+    def window(self, start: int, stop: int) -> 'Recording':
+        """Return samples ``start:stop`` as a new recording."""
+        return replace(self, t_s=self.t_s[start:stop], command=self.command[start:stop],
+                       measurement=self.measurement[start:stop])
+
+    def split(self, train_fraction: float = 0.7) -> tuple['Recording', 'Recording']:
+        """Split in time into a training part and the held-out rest.
+
+        Parameters
+        ----------
+        train_fraction : float
+            Fraction of the *duration* (not of the samples) used for training.
+
+        Returns
+        -------
+        tuple of Recording
+            ``(train, holdout)``.
+        """
+        if not 0.0 < train_fraction < 1.0:
+            raise RecordingError(f'train fraction must be in (0, 1), got {train_fraction}')
+        t_cut = self.t_s[0] + train_fraction * self.duration_s
+        k = int(np.searchsorted(self.t_s, t_cut))
+        return self.window(0, k), self.window(k, self.n_samples)
+
+
+def count_reversals(command: np.ndarray, tolerance: float | None = None) -> int:
+    """Count direction reversals of a command, ignoring wiggles below a tolerance.
+
+    Parameters
+    ----------
+    command : numpy.ndarray
+        Command samples.
+    tolerance : float, optional
+        Smallest excursion that counts as a move; default 2 % of the
+        command's range.
+
+    Returns
+    -------
+    int
+        Number of times the command changes direction by more than the
+        tolerance.
+    """
+    command = np.asarray(command, dtype=float)
+    span = float(np.ptp(command)) if command.size else 0.0
+    if span <= 0.0:
+        return 0
+    tol = 0.02 * span if tolerance is None else float(tolerance)
+    reversals = 0
+    direction = 0
+    anchor = command[0]
+    for value in command[1:]:
+        if direction >= 0 and value < anchor - tol:
+            reversals += direction > 0
+            direction, anchor = -1, value
+        elif direction <= 0 and value > anchor + tol:
+            reversals += direction < 0
+            direction, anchor = 1, value
+        elif (direction > 0 and value > anchor) or (direction < 0 and value < anchor):
+            anchor = value
+    return int(reversals)
+
+
+def validate_recording(rec: Recording, *, min_samples: int = MIN_SAMPLES,
+                       min_reversals: int = 2) -> Recording:
+    """Check a recording and return it with float64 arrays.
+
+    Parameters
+    ----------
+    rec : Recording
+        The recording to check.
+    min_samples : int
+        Fewest samples accepted.
+    min_reversals : int
+        Fewest command reversals accepted (a loop needs a rise and a fall).
+
+    Returns
+    -------
+    Recording
+        The same data as contiguous float64 arrays.
+
+    Raises
+    ------
+    RecordingError
+        Wrong channel, mismatched lengths, too few samples, NaN/inf,
+        duplicate or decreasing timestamps.
+    NoExcitationError
+        The command does not reverse often enough to excite the loop.
+    """
+    if rec.channel not in CHANNELS:
+        raise RecordingError(f'unknown channel {rec.channel!r}; expected one of {CHANNELS}')
+    arrays = {}
+    for name in ('t_s', 'command', 'measurement'):
+        try:
+            arr = np.ascontiguousarray(np.asarray(getattr(rec, name), dtype=np.float64))
+        except (TypeError, ValueError) as exc:
+            raise RecordingError(f'{name} is not numeric: {exc}') from None
+        if arr.ndim != 1:
+            raise RecordingError(f'{name} must be one-dimensional, got shape {arr.shape}')
+        arrays[name] = arr
+    n = arrays['t_s'].shape[0]
+    if arrays['command'].shape[0] != n or arrays['measurement'].shape[0] != n:
+        raise RecordingError(
+            f'length mismatch: {n} times, {arrays["command"].shape[0]} commands, '
+            f'{arrays["measurement"].shape[0]} measurements')
+    if n < min_samples:
+        raise RecordingError(f'too few samples: {n} (need at least {min_samples})')
+    for name, arr in arrays.items():
+        bad = ~np.isfinite(arr)
+        if bad.any():
+            first = int(np.argmax(bad))
+            raise RecordingError(
+                f'{name} has {int(bad.sum())} NaN/inf values (first at sample {first})')
+    dt = np.diff(arrays['t_s'])
+    if (dt == 0).any():
+        first = int(np.argmax(dt == 0)) + 1
+        raise RecordingError(
+            f'duplicate timestamps: {int((dt == 0).sum())} (first at sample {first}, '
+            f't={arrays["t_s"][first]:.6g} s)')
+    if (dt < 0).any():
+        first = int(np.argmax(dt < 0)) + 1
+        raise RecordingError(
+            f'time goes backwards at {int((dt < 0).sum())} samples (first at sample {first}, '
+            f't={arrays["t_s"][first]:.6g} s)')
+    if np.ptp(arrays['command']) <= 0.0:
+        raise NoExcitationError('command is constant: nothing excites the hysteresis loop')
+    reversals = count_reversals(arrays['command'])
+    if reversals < min_reversals:
+        raise NoExcitationError(
+            f'command reverses {reversals} time(s); identification needs at least '
+            f'{min_reversals} reversals to excite the hysteresis loop')
+    if np.ptp(arrays['measurement']) <= 0.0:
+        raise RecordingError('measurement is constant: the sensor shows no response')
+    return replace(rec, **arrays)

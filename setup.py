@@ -1,0 +1,51 @@
+"""Packaging for hyst_id (ament_python, shaped like demo_nodes_py)."""
+
+from glob import glob
+
+from setuptools import find_packages, setup
+
+package_name = 'hyst_id'
+
+NODES = ['actuator_driver', 'pipeline_sim', 'excitation', 'identifier', 'compensator',
+         'recorder', 'replay', 'bringup']
+
+setup(
+    name=package_name,
+    version='0.1.0',
+    packages=find_packages(exclude=['test', 'test.*', 'bench', 'bench.*']),
+    data_files=[
+        ('share/ament_index/resource_index/packages', ['resource/' + package_name]),
+        ('share/' + package_name, ['package.xml']),
+        ('share/' + package_name + '/params', glob('params/*.yaml')),
+    ],
+    python_requires='>=3.10',
+    install_requires=[
+        'setuptools',
+        'numpy>=1.24',
+        'scipy>=1.11',
+        'numba>=0.59',
+        'mcap>=1.1',
+        'mcap-ros2-support>=0.5',
+        'rosbags>=0.10',
+        'matplotlib>=3.7',
+        'pyyaml>=6',
+        'tqdm>=4.60',
+    ],
+    extras_require={
+        'ros': ['ros-rclpy', 'ros-std-msgs', 'ros-sensor-msgs', 'ros-diagnostic-msgs',
+                'ros-rcl-interfaces', 'ros-rmw-fastrtps-cpp'],
+        'test': ['pytest>=7', 'flake8>=6', 'pydocstyle>=6', 'ros-ament-flake8',
+                 'ros-ament-pep257', 'ros-ament-lint', 'cmaes>=0.10'],
+        'build': ['colcon-common-extensions', 'colcon-ros', 'catkin-pkg'],
+    },
+    zip_safe=True,
+    maintainer='hyst_id maintainers',
+    maintainer_email='maintainers@hyst-id.invalid',
+    description='GAASS identification and inverse compensation of actuator hysteresis.',
+    license='Apache-2.0',
+    tests_require=['pytest'],
+    entry_points={
+        'console_scripts': [f'{node} = hyst_id.nodes.{node}:main' for node in NODES]
+        + ['hyst-id = hyst_id.cli:main'],
+    },
+)
