@@ -24,14 +24,14 @@ pressure   ... + tau_s (first-order sensor)                 12
 flow       ... + zeta omega_n (second-order sensor)         13
 =========  ==========================================  ===========
 
-Pressure and flow arrive in the sensor's own units (kPa, psi, g/s), so an
+Measurements arrive in the sensor's own units (mm, kPa, psi, g/s), so an
 affine calibration ``y = k s + b`` follows the sensor dynamics. By default
 ``k`` and ``b`` are *profiled out*: for every candidate the best ``(k, b)`` is
 the closed-form linear least-squares fit, so the optimiser searches only the
 physical parameters and the calibration is always exact for the candidate
-(variable projection). A fixed calibration can be given instead. The
-position channel is read in the hysteresis output's units (calibration
-``k = 1, b = 0``), as in the paper.
+(variable projection). A fixed calibration can be given instead (the
+paper's position chain is ``k = 1, b = 0``). Results are reported in the
+canonical gauge (:mod:`hyst_id.gauge`), where the calibration is ``(1, 0)``.
 
 The population kernel :func:`population_cost` simulates the chain for a
 whole population and returns the paper's cost J (Eq. 6) per candidate with
@@ -43,13 +43,18 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 from typing import Callable, Mapping
 
-import numpy as np
 from numba import njit
+import numpy as np
 
 from hyst_id.errors import ConfigError, InvalidParametersError
 from hyst_id.models.backlash import BACKLASH_NAMES, backlash_step, check_backlash
-from hyst_id.models.hysteresis import (HYSTERESIS_NAMES, check_hysteresis,
-                                       hysteresis_step, initial_output)
+from hyst_id.models.hysteresis import (
+    check_hysteresis,
+    hysteresis_feasible,
+    HYSTERESIS_NAMES,
+    hysteresis_step,
+    initial_output,
+)
 from hyst_id.models.sensors import first_order_coefficient, second_order_coefficients
 
 __all__ = [
@@ -87,9 +92,16 @@ PAPER_DOMAINS = {
 
 @njit(cache=True)
 def _feasible(p):
-    m_min = min(p[0], p[1])
-    return (p[0] > 0.0 and p[1] > 0.0 and 0.0 < p[2] < m_min and 0.0 < p[3] < m_min
-            and p[4] < p[5] and p[6] > p[7] and p[8] > 0.0 and p[9] < p[10])
+    return (hysteresis_feasible(p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7])
+            and p[8] > 0.0 and p[9] < p[10])
+
+
+@njit(cache=True)
+def _feasible_rows(pop):
+    ok = np.empty(pop.shape[0], dtype=np.bool_)
+    for i in range(pop.shape[0]):
+        ok[i] = np.all(np.isfinite(pop[i])) and _feasible(pop[i])
+    return ok
 
 
 @njit(cache=True)
@@ -273,12 +285,8 @@ class ChainSpec:
 
     def feasible(self, pop: np.ndarray) -> np.ndarray:
         """Boolean mask of the rows of ``pop`` that satisfy every constraint."""
-        pop = np.atleast_2d(np.asarray(pop, dtype=np.float64))
-        m_min = np.minimum(pop[:, 0], pop[:, 1])
-        ok = ((pop[:, 0] > 0) & (pop[:, 1] > 0) & (pop[:, 2] > 0) & (pop[:, 2] < m_min)
-              & (pop[:, 3] > 0) & (pop[:, 3] < m_min) & (pop[:, 4] < pop[:, 5])
-              & (pop[:, 6] > pop[:, 7]) & (pop[:, 8] > 0) & (pop[:, 9] < pop[:, 10]))
-        return ok & np.all(np.isfinite(pop), axis=1)
+        pop = np.ascontiguousarray(np.atleast_2d(pop), dtype=np.float64)
+        return _feasible_rows(pop)
 
     def cost_function(self, t_s: np.ndarray, command: np.ndarray,
                       measurement: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
@@ -383,13 +391,13 @@ def chain_spec(channel: str, domains: Mapping[str, tuple[float, float]] | None =
     domains : mapping, optional
         Search domains overriding the paper's, by parameter name.
     calibration : tuple of float, optional
-        Fixed ``(k, b)`` for pressure/flow; default profiled. The position
-        chain always uses ``(1, 0)``.
+        Fixed ``(k, b)``; default profiled (fitted per candidate), for the
+        position channel too: H and B already carry a scale and an offset, so
+        profiling adds no freedom, but it lets the search run in the
+        command's scale whatever units the measurement has.
     """
     if channel not in CHAIN_NAMES:
         raise ConfigError(f'unknown channel {channel!r}; expected one of {tuple(CHAIN_NAMES)}')
-    if channel == 'position':
-        calibration = (1.0, 0.0)
     base = np.array([PAPER_DOMAINS[n] for n in CHAIN_NAMES[channel]], dtype=float)
     spec = ChainSpec(channel=channel, bounds=base, calibration=calibration)
     if domains:

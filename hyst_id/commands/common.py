@@ -20,7 +20,7 @@ import argparse
 
 import yaml
 
-from hyst_id.chains import CHAIN_NAMES, ChainSpec, chain_spec
+from hyst_id.chains import CHAIN_NAMES, chain_spec, ChainSpec
 from hyst_id.errors import ConfigError
 from hyst_id.identify import IdentifySettings
 from hyst_id.io.recording import Recording
@@ -59,7 +59,7 @@ def add_settings_arguments(parser: argparse.ArgumentParser) -> None:
     g.add_argument('--gaass-only', action='store_true',
                    help='no refinement after GAASS (fidelity to the paper)')
     g.add_argument('--domains', default='auto', metavar='auto|paper|YAML',
-                   help='search domains: derived from the data (auto), the paper\'s '
+                   help="search domains: derived from the data (auto), the paper's "
                    'preset, or a YAML mapping name: [low, high]')
 
 

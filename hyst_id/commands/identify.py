@@ -19,8 +19,13 @@ from __future__ import annotations
 import argparse
 import sys
 
-from hyst_id.commands.common import (add_recording_arguments, add_settings_arguments,
-                                     load_recording, make_spec, make_settings)
+from hyst_id.commands.common import (
+    add_recording_arguments,
+    add_settings_arguments,
+    load_recording,
+    make_settings,
+    make_spec,
+)
 from hyst_id.identify import identify
 
 __all__ = ['add_arguments', 'run']

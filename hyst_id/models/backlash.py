@@ -25,8 +25,8 @@ collide with the hysteresis bottom slope. Initial state: on the rising edge,
 
 from __future__ import annotations
 
-import numpy as np
 from numba import njit
+import numpy as np
 
 from hyst_id.errors import InvalidParametersError
 

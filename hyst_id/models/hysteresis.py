@@ -36,8 +36,8 @@ just been driven up to its starting command (:func:`initial_output`).
 
 from __future__ import annotations
 
-import numpy as np
 from numba import njit
+import numpy as np
 
 from hyst_id.errors import InvalidParametersError
 
@@ -45,6 +45,7 @@ __all__ = [
     'HYSTERESIS_NAMES',
     'check_hysteresis',
     'hysteresis_feasible',
+    'loop_corners',
     'initial_output',
     'hysteresis_step',
     'hysteresis_inverse_step',
@@ -57,10 +58,23 @@ HYSTERESIS_NAMES = ('m_l', 'm_r', 'm_t', 'm_b', 'c_l', 'c_r', 'c_t', 'c_b')
 
 @njit(cache=True, inline='always')
 def hysteresis_feasible(m_l, m_r, m_t, m_b, c_l, c_r, c_t, c_b):
-    """Return True when the eight parameters satisfy the loop constraints."""
+    """Return True when the parameters satisfy the paper's constraints and the loop is proper.
+
+    Besides the paper's constraints, the four corners must form a proper
+    quadrilateral (see :func:`loop_corners`): the left line meets the bottom
+    and the top lines before the right line does, and meets the bottom
+    before the top. The paper's constraints alone admit loops whose left and
+    right lines cross inside the band, on which H jumps and H^-1 fails.
+    """
     m_min = min(m_l, m_r)
-    return (m_l > 0.0 and m_r > 0.0 and 0.0 < m_t < m_min and 0.0 < m_b < m_min
-            and c_l < c_r and c_t > c_b)
+    if not (m_l > 0.0 and m_r > 0.0 and 0.0 < m_t < m_min and 0.0 < m_b < m_min
+            and c_l < c_r and c_t > c_b):
+        return False
+    v_a = (c_b + m_l * c_l) / (m_l - m_b)
+    v_b = (c_b + m_r * c_r) / (m_r - m_b)
+    v_c = (c_t + m_r * c_r) / (m_r - m_t)
+    v_d = (c_t + m_l * c_l) / (m_l - m_t)
+    return v_a < v_b and v_d < v_c and v_a < v_d and v_b < v_c
 
 
 @njit(cache=True, inline='always')
@@ -119,6 +133,21 @@ def _invert(p, u_d, v0, u0):
     return v
 
 
+def loop_corners(params: np.ndarray) -> dict[str, tuple[float, float]]:
+    """Corners of the major loop as ``(v, u)``.
+
+    ``A`` left-bottom, ``B`` right-bottom, ``C`` right-top (the paper's
+    ``v_1``), ``D`` left-top; ``A`` is the paper's ``v_2``.
+    """
+    m_l, m_r, m_t, m_b, c_l, c_r, c_t, c_b = np.asarray(params, dtype=float)
+    v_a = (c_b + m_l * c_l) / (m_l - m_b)
+    v_b = (c_b + m_r * c_r) / (m_r - m_b)
+    v_c = (c_t + m_r * c_r) / (m_r - m_t)
+    v_d = (c_t + m_l * c_l) / (m_l - m_t)
+    return {'A': (v_a, m_b * v_a + c_b), 'B': (v_b, m_b * v_b + c_b),
+            'C': (v_c, m_t * v_c + c_t), 'D': (v_d, m_t * v_d + c_t)}
+
+
 def check_hysteresis(params: np.ndarray) -> np.ndarray:
     """Return ``params`` as float64, or raise if they violate the constraints.
 
@@ -147,6 +176,11 @@ def check_hysteresis(params: np.ndarray) -> np.ndarray:
     for ok, rule in checks:
         if not ok:
             raise InvalidParametersError(f'hysteresis parameters violate {rule}')
+    if not hysteresis_feasible(m_l, m_r, m_t, m_b, c_l, c_r, c_t, c_b):
+        corners = {k: round(v[0], 4) for k, v in loop_corners(p).items()}
+        raise InvalidParametersError(
+            'hysteresis loop is not proper: the left and right lines cross inside the '
+            f'band (corner commands {corners} need A < B, D < C, A < D, B < C)')
     return p
 
 

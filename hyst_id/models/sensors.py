@@ -34,8 +34,8 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
 from numba import njit
+import numpy as np
 
 __all__ = [
     'first_order_coefficient',
