@@ -219,7 +219,8 @@ def population_cost(pop, kind, v, y, dt_s, uniform, profile, k_fixed, b_fixed):
             continue
         _chain_signal(p, kind, v, dt_s, uniform, s)
         if profile:
-            costs[i] = _fit_affine(s, y)[2]
+            k, b, _ = _fit_affine(s, y)
+            costs[i] = _sse(s, y, k, b)   # second pass: no cancellation
         else:
             costs[i] = _sse(s, y, k_fixed, b_fixed)
     return costs

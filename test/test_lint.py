@@ -39,9 +39,9 @@ def test_flake8():
 def test_pep257():
     """ament_pep257 with the numpy docstring convention."""
     ament_pep257 = pytest.importorskip('ament_pep257.main')
-    rc = ament_pep257.main(argv=['--convention', 'numpy', '--add-ignore', 'D100', 'D101',
-                                 'D102', 'D103', 'D104', 'D105', 'D106', 'D107',
-                                 *TARGETS])
+    rc = ament_pep257.main(argv=[*TARGETS, '--convention', 'numpy', '--add-ignore',
+                                 'D100', 'D101', 'D102', 'D103', 'D104', 'D105', 'D106',
+                                 'D107'])
     assert rc == 0, 'pep257 docstring errors (see output above)'
 
 
