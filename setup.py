@@ -44,6 +44,7 @@ setup(
         'matplotlib>=3.7',
         'pyyaml>=6',
         'tqdm>=4.60',
+        'threadpoolctl>=3',
     ],
     extras_require={
         'ros': ['ros-rclpy', 'ros-std-msgs', 'ros-sensor-msgs', 'ros-diagnostic-msgs',

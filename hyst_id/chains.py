@@ -314,6 +314,17 @@ class ChainSpec:
                       dt, uniform, out)
         return out
 
+    def residual(self, params: np.ndarray, t_s: np.ndarray, command: np.ndarray,
+                 measurement: np.ndarray) -> np.ndarray:
+        """Measurement minus chain output, with the calibration profiled if it is."""
+        s = self.signal(params, t_s, command)
+        y = np.ascontiguousarray(measurement, dtype=np.float64)
+        if self.profiled:
+            k, b, _ = _fit_affine(s, y)
+        else:
+            k, b = self.calibration
+        return y - (k * s + b)
+
     def fit_calibration(self, params: np.ndarray, t_s: np.ndarray, command: np.ndarray,
                         measurement: np.ndarray) -> tuple[float, float]:
         """Calibration ``(k, b)`` for ``params``: fitted if profiled, else the fixed one."""

@@ -24,15 +24,18 @@ noise floor.
 
 from __future__ import annotations
 
+from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
+from dataclasses import asdict, dataclass, field
 import multiprocessing
 import os
-from concurrent.futures import ProcessPoolExecutor
-from dataclasses import asdict, dataclass, field
+import threading
 from typing import Callable
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
-from hyst_id.chains import ChainSpec, chain_spec, er_percent
+from hyst_id.chains import chain_spec, ChainSpec, er_percent
 from hyst_id.errors import IdentificationError, InvalidParametersError
 from hyst_id.gaass import GaassSolver
 from hyst_id.gauge import canonical_gauge
@@ -59,7 +62,14 @@ class IdentifySettings:
     refine : bool
         Polish each GAASS result with bounded least squares (GAASS-only when False).
     refine_max_nfev : int
-        Cost evaluations allowed to the refinement of one seed.
+        Cost evaluations allowed to each refinement.
+    refine_top : int
+        How many of the best distinct chromosomes of a GAASS run are refined.
+    restarts : int
+        Extra GAASS runs (new derived seeds) while %e_r is above
+        ``restart_factor`` times the estimated noise floor (refinement on only).
+    restart_factor : float
+        Restarts stop once %e_r is within this factor of the noise floor.
     er_bound_percent : float or None
         Stop a GAASS run early once %e_r falls below this bound.
     """
@@ -71,7 +81,10 @@ class IdentifySettings:
     seeds: tuple[int, ...] = tuple(range(10))
     workers: int = 0
     refine: bool = True
-    refine_max_nfev: int = 4000
+    refine_max_nfev: int = 2000
+    refine_top: int = 3
+    restarts: int = 4
+    restart_factor: float = 1.05
     er_bound_percent: float | None = None
 
 
@@ -166,34 +179,84 @@ class Identification:
 
 
 def run_seed(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray, measurement: np.ndarray,
-             settings: IdentifySettings, seed: int) -> SeedRun:
-    """Run GAASS (and refinement) for one seed; picklable for worker processes."""
+             settings: IdentifySettings, seed: int, floor_percent: float = 0.0) -> SeedRun:
+    """Identify with one seed: GAASS, refinement, restarts; picklable for workers.
+
+    The first GAASS run uses ``seed`` itself (the paper's procedure). With
+    refinement on, the ``refine_top`` best distinct chromosomes of the final
+    population are polished and the best kept; while %e_r stays above
+    ``restart_factor`` times the noise floor, GAASS restarts with a seed
+    derived from ``(seed, restart)``, up to ``restarts`` times.
+    """
+    with threadpool_limits(limits=1):   # parallelism is over seeds, not inside BLAS
+        return _run_seed(spec, t_s, command, measurement, settings, seed, floor_percent)
+
+
+def _run_seed(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray, measurement: np.ndarray,
+              settings: IdentifySettings, seed: int, floor_percent: float) -> SeedRun:
     cost = spec.cost_function(t_s, command, measurement)
+    sum_sq = float(np.sum(measurement ** 2))
     target = None
     if settings.er_bound_percent is not None:
-        target = (settings.er_bound_percent / 100.0) ** 2 * float(np.sum(measurement ** 2))
-    solver = GaassSolver(cost, spec.bounds, feasible=spec.feasible, pop_size=settings.pop_size,
-                         maxiter=settings.maxiter, c=settings.c, xi=settings.xi,
-                         target=target, rng=seed)
-    res = solver.solve()
-    x_raw, fun, nfev = np.asarray(res.x, dtype=float), float(res.fun), int(res.nfev)
-    er_ga = float(er_percent(fun, measurement))
-    if settings.refine:
-        x_ref, fun_ref, nfev_ref = refine(spec, x_raw, t_s, command, measurement,
-                                          max_nfev=settings.refine_max_nfev)
-        nfev += nfev_ref
-        if fun_ref < fun:
-            x_raw, fun = x_ref, fun_ref
-    k, b = spec.fit_calibration(x_raw, t_s, command, measurement)
-    if k > 0:
-        x = canonical_gauge(x_raw, (k, b))
-    else:
-        x = x_raw.copy()
-    return SeedRun(seed=int(seed), x_raw=x_raw, x=x, fun=fun,
-                   er_percent=float(er_percent(fun, measurement)), er_gaass_percent=er_ga,
-                   nfev=nfev, nit=int(res.nit),
-                   best_history=np.asarray(res.history.best_fun, dtype=float),
-                   message=str(res.message))
+        target = (settings.er_bound_percent / 100.0) ** 2 * sum_sq
+    good_enough = (settings.restart_factor * floor_percent / 100.0) ** 2 * sum_sq
+    best_x, best_fun, er_ga, nfev, nit, history, message = None, np.inf, np.nan, 0, 0, None, ''
+    for restart in range(1 + (settings.restarts if settings.refine else 0)):
+        rng = seed if restart == 0 else np.random.default_rng([seed, restart])
+        solver = GaassSolver(cost, spec.bounds, feasible=spec.feasible,
+                             pop_size=settings.pop_size, maxiter=settings.maxiter, c=settings.c,
+                             xi=settings.xi, target=target, rng=rng)
+        res = solver.solve()
+        nfev += int(res.nfev)
+        nit += int(res.nit)
+        if restart == 0:
+            er_ga = float(er_percent(res.fun, measurement))
+            history, message = np.asarray(res.history.best_fun, dtype=float), str(res.message)
+        candidates = [(np.asarray(res.x, dtype=float), float(res.fun))]
+        if settings.refine:
+            candidates = []
+            for x0 in _distinct_best(res.population, res.population_fun, settings.refine_top):
+                x_ref, fun_ref, nfev_ref = refine(spec, x0, t_s, command, measurement,
+                                                  max_nfev=settings.refine_max_nfev)
+                nfev += nfev_ref
+                candidates.append((x_ref, fun_ref))
+        for x, fun in candidates:
+            if fun < best_fun:
+                best_x, best_fun = x, fun
+        if best_fun <= good_enough or (target is not None and best_fun <= target):
+            break
+    k, b = spec.fit_calibration(best_x, t_s, command, measurement)
+    x = canonical_gauge(best_x, (k, b)) if k > 0 else best_x.copy()
+    return SeedRun(seed=int(seed), x_raw=best_x, x=x, fun=float(best_fun),
+                   er_percent=float(er_percent(best_fun, measurement)), er_gaass_percent=er_ga,
+                   nfev=nfev, nit=nit, best_history=history, message=message)
+
+
+def _distinct_best(pop: np.ndarray, fun: np.ndarray, count: int) -> list[np.ndarray]:
+    """The ``count`` best finite rows of a population, skipping duplicates."""
+    order = np.argsort(np.where(np.isfinite(fun), fun, np.inf))
+    chosen: list[np.ndarray] = []
+    for i in order:
+        if not np.isfinite(fun[i]):
+            break
+        if any(np.allclose(pop[i], c, rtol=1e-9, atol=1e-12) for c in chosen):
+            continue
+        chosen.append(np.asarray(pop[i], dtype=float))
+        if len(chosen) == count:
+            break
+    return chosen
+
+
+def _mp_context():
+    """Fork where it is safe (no other threads, POSIX), spawn otherwise.
+
+    Fork needs no ``if __name__ == '__main__'`` guard in user scripts and
+    reuses the compiled numba kernels; with threads running (a ROS
+    executor) only spawn is safe.
+    """
+    if 'fork' in multiprocessing.get_all_start_methods() and threading.active_count() == 1:
+        return multiprocessing.get_context('fork')
+    return multiprocessing.get_context('spawn')
 
 
 def _n_workers(settings: IdentifySettings) -> int:
@@ -229,22 +292,27 @@ def identify(recording: Recording, *, spec: ChainSpec | None = None,
             f'chain is for {spec.channel!r} but the recording is {rec.channel!r}')
     if not settings.seeds:
         raise IdentificationError('no seeds given')
+    floor = noise_floor_percent(rec.measurement)
     args = (spec, rec.t_s, rec.command, rec.measurement, settings)
     runs: list[SeedRun] = []
     n_workers = _n_workers(settings)
     if n_workers == 1:
         for seed in settings.seeds:
-            runs.append(run_seed(*args, seed))
+            runs.append(run_seed(*args, seed, floor))
             if progress:
                 progress(len(runs), len(settings.seeds), runs[-1])
     else:
-        ctx = multiprocessing.get_context('spawn')
-        with ProcessPoolExecutor(max_workers=n_workers, mp_context=ctx) as pool:
-            futures = [pool.submit(run_seed, *args, seed) for seed in settings.seeds]
-            for fut in futures:
-                runs.append(fut.result())
-                if progress:
-                    progress(len(runs), len(settings.seeds), runs[-1])
+        # Limit BLAS threads in the parent too: forked children inherit its pools.
+        with threadpool_limits(limits=1), ProcessPoolExecutor(
+                max_workers=n_workers, mp_context=_mp_context()) as pool:
+            futures = [pool.submit(run_seed, *args, seed, floor) for seed in settings.seeds]
+            try:
+                for fut in futures:
+                    runs.append(fut.result())
+                    if progress:
+                        progress(len(runs), len(settings.seeds), runs[-1])
+            except BrokenProcessPool as exc:
+                raise IdentificationError(f'a worker process died: {exc}') from None
     return summarise(rec, spec, settings, runs)
 
 

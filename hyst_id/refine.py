@@ -74,13 +74,7 @@ def refine(spec: ChainSpec, x0: np.ndarray, t_s: np.ndarray, command: np.ndarray
         nfev += 1
         if not spec.feasible(x[None, :])[0]:
             return penalty
-        s = spec.signal(x, t_s, command)
-        if spec.profiled:
-            a = np.vstack([s, np.ones_like(s)]).T
-            coef, *_ = np.linalg.lstsq(a, y, rcond=None)
-            return y - a @ coef
-        k, b = spec.calibration
-        return y - (k * s + b)
+        return spec.residual(x, t_s, command, y)
 
     x_best = np.clip(np.asarray(x0, dtype=np.float64), lo, hi)
     f_best = float(cost(x_best[None, :])[0])

@@ -1,0 +1,70 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""Shared fixtures: recordings simulated from known parameters with fixed seeds."""
+
+from __future__ import annotations
+
+import itertools
+import os
+
+import numpy as np
+import pytest
+
+from hyst_id.chains import chain_spec
+from hyst_id.io.recording import Recording
+
+#: The paper's induced hysteresis plus a unit-slope backlash of 0.3 mA width,
+#: a 0.5 s pressure lag and a 0.6 / 0.5 rad/s flow sensor.
+TRUE_PARAMS = np.array([1.01, 1.05, 0.10, 0.15, -0.25, 0.50, 14.0, 7.0,
+                        1.0, -0.15, 0.15, 0.5, 0.6])
+#: Affine sensor calibration per channel (output units per position unit, offset).
+CALIBRATION = {'position': (1.0, 0.0), 'pressure': (50.0, 1000.0), 'flow': (4.0, 2.0)}
+
+_domain_ids = itertools.count(60)
+
+
+def simulate_channel(channel: str, *, noise_percent: float = 0.5, seed: int = 1,
+                     duration_s: float = 100.0, dt_s: float = 0.05):
+    """Simulate the Eq. 24 run of a channel; return (recording, noise-free output)."""
+    spec = chain_spec(channel)
+    t = np.arange(0.0, duration_s, dt_s)
+    v = 9.0 + 2.0 * np.exp(-0.01 * t) * np.sin(2 * np.pi * t / 10.0)
+    y0 = spec.simulate(TRUE_PARAMS[:spec.n_params], t, v, CALIBRATION[channel])
+    sigma = noise_percent / 100.0 * np.sqrt(np.mean(y0 ** 2))
+    y = y0 + np.random.default_rng(seed).normal(0.0, sigma, t.size)
+    rec = Recording(t, v, y, channel, 'mA', '', f'simulated {channel}')
+    return rec, y0
+
+
+@pytest.fixture(scope='session')
+def simulated():
+    """Factory of simulated recordings, cached per channel."""
+    cache = {}
+
+    def get(channel: str):
+        if channel not in cache:
+            cache[channel] = simulate_channel(channel)
+        return cache[channel]
+
+    return get
+
+
+@pytest.fixture
+def ros_domain(monkeypatch):
+    """A ROS domain id of its own for this test, localhost discovery only."""
+    domain = str(next(_domain_ids) + (os.getpid() % 40))
+    monkeypatch.setenv('ROS_DOMAIN_ID', domain)
+    monkeypatch.setenv('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
+    return int(domain)
