@@ -109,8 +109,8 @@ def test_infeasible_hysteresis_is_rejected_with_the_rule(bad, rule):
 
 
 def nonuniform_times(n=400, seed=0):
-    return np.concatenate([[0.0], np.cumsum(np.random.default_rng(seed).uniform(0.01, 0.1,
-                                                                               n - 1))])
+    steps = np.random.default_rng(seed).uniform(0.01, 0.1, n - 1)
+    return np.concatenate([[0.0], np.cumsum(steps)])
 
 
 @pytest.mark.parametrize('zeta', [0.2, 0.7, 1.0, 1.8])
@@ -157,7 +157,6 @@ def test_population_kernel_matches_single_simulation(channel):
 
 
 def test_kernel_marks_infeasible_and_nonfinite_rows_inf():
-    spec = chain_spec('position')
     t = np.arange(100) * 0.1
     v = np.sin(t)
     pop = np.array([TRUE[:11], TRUE[:11]])
