@@ -49,8 +49,9 @@ setup(
     extras_require={
         'ros': ['ros-rclpy', 'ros-std-msgs', 'ros-sensor-msgs', 'ros-diagnostic-msgs',
                 'ros-rcl-interfaces', 'ros-rmw-fastrtps-cpp'],
-        'test': ['pytest>=7', 'flake8>=6', 'pydocstyle>=6', 'ros-ament-flake8',
-                 'ros-ament-pep257', 'ros-ament-lint', 'cmaes>=0.10'],
+        'test': ['pytest>=7', 'flake8>=6', 'flake8-import-order', 'flake8-quotes',
+                 'flake8-builtins', 'flake8-comprehensions', 'pydocstyle>=6',
+                 'ros-ament-flake8', 'ros-ament-pep257', 'ros-ament-lint', 'cmaes>=0.10'],
         'build': ['colcon-common-extensions', 'colcon-ros', 'catkin-pkg'],
     },
     zip_safe=True,
