@@ -41,6 +41,13 @@ CHANNELS = ('position', 'pressure', 'flow')
 #: Fewest samples an identification can work with.
 MIN_SAMPLES = 20
 
+#: Largest magnitude accepted in any column; beyond it squares overflow.
+MAX_ABS_VALUE = 1e15
+
+#: A gap longer than this many median sample intervals means the file holds
+#: more than one run (or lost data) and is refused.
+MAX_GAP_FACTOR = 1000.0
+
 
 @dataclass(frozen=True)
 class Recording:
@@ -151,7 +158,8 @@ def count_reversals(command: np.ndarray, tolerance: float | None = None) -> int:
 
 
 def validate_recording(rec: Recording, *, min_samples: int = MIN_SAMPLES,
-                       min_reversals: int = 2) -> Recording:
+                       min_reversals: int = 2,
+                       max_gap_factor: float = MAX_GAP_FACTOR) -> Recording:
     """Check a recording and return it with float64 arrays.
 
     Parameters
@@ -162,6 +170,8 @@ def validate_recording(rec: Recording, *, min_samples: int = MIN_SAMPLES,
         Fewest samples accepted.
     min_reversals : int
         Fewest command reversals accepted (a loop needs a rise and a fall).
+    max_gap_factor : float
+        Largest sample interval accepted, in median intervals.
 
     Returns
     -------
@@ -171,8 +181,9 @@ def validate_recording(rec: Recording, *, min_samples: int = MIN_SAMPLES,
     Raises
     ------
     RecordingError
-        Wrong channel, mismatched lengths, too few samples, NaN/inf,
-        duplicate or decreasing timestamps.
+        Wrong channel, mismatched lengths, too few samples, NaN/inf, values
+        too large to square, duplicate or decreasing timestamps, a gap longer
+        than ``max_gap_factor`` median intervals.
     NoExcitationError
         The command does not reverse often enough to excite the loop.
     """
@@ -200,6 +211,11 @@ def validate_recording(rec: Recording, *, min_samples: int = MIN_SAMPLES,
             first = int(np.argmax(bad))
             raise RecordingError(
                 f'{name} has {int(bad.sum())} NaN/inf values (first at sample {first})')
+    for name, arr in arrays.items():
+        peak = float(np.max(np.abs(arr)))
+        if peak > MAX_ABS_VALUE:
+            raise RecordingError(f'{name} has values up to {peak:.3g}, beyond {MAX_ABS_VALUE:.0e}:'
+                                 ' wrong units or a corrupt file?')
     dt = np.diff(arrays['t_s'])
     if (dt == 0).any():
         first = int(np.argmax(dt == 0)) + 1
@@ -211,6 +227,13 @@ def validate_recording(rec: Recording, *, min_samples: int = MIN_SAMPLES,
         raise RecordingError(
             f'time goes backwards at {int((dt < 0).sum())} samples (first at sample {first}, '
             f't={arrays["t_s"][first]:.6g} s)')
+    median_dt = float(np.median(dt))
+    if dt.max() > max_gap_factor * median_dt:
+        first = int(np.argmax(dt)) + 1
+        raise RecordingError(
+            f'gap of {dt.max():.6g} s at sample {first} (t={arrays["t_s"][first]:.6g} s) is '
+            f'{dt.max() / median_dt:.0f} x the median interval {median_dt:.3g} s: '
+            'split the recording or pass a larger max_gap_factor')
     if np.ptp(arrays['command']) <= 0.0:
         raise NoExcitationError('command is constant: nothing excites the hysteresis loop')
     reversals = count_reversals(arrays['command'])
