@@ -30,17 +30,21 @@ two samples.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
+import math
 from typing import Mapping
 
 import numpy as np
 
 from hyst_id.errors import InvalidParametersError
 from hyst_id.models.backlash import backlash_inverse_step, backlash_step, check_backlash
-from hyst_id.models.hysteresis import (HYSTERESIS_NAMES, check_hysteresis,
-                                       hysteresis_inverse_step, hysteresis_step,
-                                       initial_output)
+from hyst_id.models.hysteresis import (
+    check_hysteresis,
+    hysteresis_inverse_step,
+    HYSTERESIS_NAMES,
+    hysteresis_step,
+    initial_output,
+)
 
 __all__ = ['InverseModel', 'CommandLimits', 'Compensator']
 

@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from hyst_id.chains import PARAM_UNITS, er_percent
+from hyst_id.chains import er_percent, PARAM_UNITS
 from hyst_id.identify import Identification
 from hyst_id.io.recording import Recording
 
