@@ -127,8 +127,8 @@ CASES = [
      'no data'),
     ('missing-column', lambda d: [str(write_csv(d / 'm.csv', header='t,cmd,measurement'))],
      'command'),
-    ('non-numeric-cell', lambda d: [str(_text(d / 'x.csv', 't,command,measurement\n'
-                                               '0,1,2\n0.1,abc,2\n'))], 'line'),
+    ('non-numeric-cell',
+     lambda d: [str(_text(d / 'x.csv', 't,command,measurement\n0,1,2\n0.1,abc,2\n'))], 'line'),
     ('ragged-rows', lambda d: [str(_text(d / 'r.csv', 't,command,measurement\n0,1,2\n0.1,2\n'))],
      'line'),
     ('nan-measurement', lambda d: [str(write_csv(d / 'n.csv', y=nan_at(Y)))], 'NaN'),
