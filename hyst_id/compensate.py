@@ -51,10 +51,16 @@ __all__ = ['InverseModel', 'CommandLimits', 'Compensator']
 
 @dataclass(frozen=True)
 class InverseModel:
-    """A validated hysteresis + backlash parameter set (canonical gauge)."""
+    """A validated hysteresis + backlash parameter set (canonical gauge).
+
+    ``output_sign`` is the canonical calibration gain: -1 when the measured
+    channel falls as the actuator output rises (the model then works on the
+    negated measurement).
+    """
 
     hysteresis: tuple[float, ...]
     backlash: tuple[float, float, float]
+    output_sign: float = 1.0
 
     @classmethod
     def from_mapping(cls, values: Mapping[str, float]) -> 'InverseModel':
@@ -65,18 +71,23 @@ class InverseModel:
         try:
             h = check_hysteresis([float(values[n]) for n in HYSTERESIS_NAMES])
             b = check_backlash([float(values[n]) for n in ('m_bl', 'c_bl', 'c_br')])
+            sign = float(values.get('output_sign', 1.0))
         except (TypeError, ValueError) as exc:
             raise InvalidParametersError(f'parameters must be numbers: {exc}') from None
-        return cls(tuple(float(x) for x in h), (float(b[0]), float(b[1]), float(b[2])))
+        if sign not in (1.0, -1.0):
+            raise InvalidParametersError(f'output_sign must be +1 or -1, got {sign}')
+        return cls(tuple(float(x) for x in h), (float(b[0]), float(b[1]), float(b[2])), sign)
 
     @classmethod
-    def from_vector(cls, params: np.ndarray) -> 'InverseModel':
+    def from_vector(cls, params: np.ndarray, output_sign: float = 1.0) -> 'InverseModel':
         """Build from a chain vector (first 11 entries: H then B)."""
         p = np.asarray(params, dtype=float).ravel()
         if p.shape[0] < 11:
             raise InvalidParametersError('need at least 11 parameters (H and B)')
+        if output_sign not in (1.0, -1.0):
+            raise InvalidParametersError(f'output_sign must be +1 or -1, got {output_sign}')
         return cls(tuple(float(x) for x in check_hysteresis(p[:8])),
-                   tuple(float(x) for x in check_backlash(p[8:11])))
+                   tuple(float(x) for x in check_backlash(p[8:11])), float(output_sign))
 
     def output_range(self, v: float) -> tuple[float, float]:
         """Lowest and highest H output reachable at command ``v`` (loop boundaries)."""
@@ -177,7 +188,8 @@ class Compensator:
         else:
             m_l, m_r, m_t, m_b, c_l, c_r, c_t, c_b = model.hysteresis
             m_bl, c_bl, c_br = model.backlash
-            u_d = backlash_inverse_step(desired, self._y, self._u, m_bl, c_bl, c_br)
+            target = model.output_sign * desired
+            u_d = backlash_inverse_step(target, self._y, self._u, m_bl, c_bl, c_br)
             v = hysteresis_inverse_step(u_d, self._v, self._u,
                                         m_l, m_r, m_t, m_b, c_l, c_r, c_t, c_b)
         v = self._limit(v, t_s)

@@ -25,8 +25,11 @@ The canonical form used for every report, average and compensator:
 
 * backlash with unit slope, centred on zero: ``m_bl = 1``,
   ``c_bl = -w``, ``c_br = +w`` (``w`` = half the dead band);
-* calibration ``k = 1, b = 0``: the hysteresis output is expressed directly
-  in the measurement's units.
+* calibration ``k = sign, b = 0`` with ``sign = +1``: the hysteresis output is
+  expressed directly in the measurement's units. A sensor whose reading
+  falls as the actuator opens (negative gain, e.g. upstream pressure) gets
+  ``sign = -1``: H is then expressed in the *negated* measurement's units,
+  because a hysteresis loop with positive slopes cannot fall.
 
 Sensor dynamics have unit DC gain, so they commute with the affine map.
 """
@@ -35,7 +38,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ['affine_map_output', 'canonical_gauge']
+__all__ = ['affine_map_output', 'canonical_gauge', 'output_sign']
 
 
 def affine_map_output(params: np.ndarray, alpha: float, delta: float) -> np.ndarray:
@@ -71,6 +74,11 @@ def affine_map_output(params: np.ndarray, alpha: float, delta: float) -> np.ndar
     return p
 
 
+def output_sign(calibration: tuple[float, float]) -> float:
+    """Sign of the canonical calibration: ``+1.0`` or ``-1.0`` (``+1`` for ``k = 0``)."""
+    return -1.0 if calibration[0] < 0 else 1.0
+
+
 def canonical_gauge(params: np.ndarray, calibration: tuple[float, float] = (1.0, 0.0)
                     ) -> np.ndarray:
     """Return the canonical representative of a parameter vector's gauge orbit.
@@ -80,18 +88,20 @@ def canonical_gauge(params: np.ndarray, calibration: tuple[float, float] = (1.0,
     params : numpy.ndarray
         Chain parameters in search space.
     calibration : tuple of float
-        ``(k, b)`` applied after the sensor. ``k`` must be positive: a
-        negative gain mirrors the loop, which no positive-slope H represents.
+        ``(k, b)`` applied after the sensor; ``k`` must be non-zero.
 
     Returns
     -------
     numpy.ndarray
-        Equivalent parameters with ``m_bl = 1``, backlash centred on 0, and
-        output in measurement units (calibration ``(1, 0)``).
+        Equivalent parameters with ``m_bl = 1``, backlash centred on 0, whose
+        chain output ``s`` gives the measurement as ``output_sign * s``
+        (calibration ``(output_sign(calibration), 0)``).
     """
     k, b = calibration
-    if not k > 0:
-        raise ValueError('calibration gain must be positive for a canonical form')
+    if k == 0 or not np.isfinite(k):
+        raise ValueError('calibration gain must be finite and non-zero')
+    sign = output_sign(calibration)
+    k, b = sign * k, sign * b       # y = sign * (|k| s + sign b)
     p = np.array(params, dtype=np.float64)
     m_bl, c_bl, c_br = p[8], p[9], p[10]
     # B output y = m_bl (u - c); write it as y = (u' - c') with u' = m_bl u.

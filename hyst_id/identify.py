@@ -38,7 +38,7 @@ from threadpoolctl import threadpool_limits
 from hyst_id.chains import chain_spec, ChainSpec, er_percent
 from hyst_id.errors import IdentificationError, InvalidParametersError
 from hyst_id.gaass import GaassSolver
-from hyst_id.gauge import canonical_gauge
+from hyst_id.gauge import canonical_gauge, output_sign
 from hyst_id.io.recording import Recording, validate_recording
 from hyst_id.noise import noise_floor_percent
 from hyst_id.refine import refine
@@ -90,11 +90,16 @@ class IdentifySettings:
 
 @dataclass
 class SeedRun:
-    """Result of one seed: GAASS, then (optionally) refinement, raw and canonical."""
+    """Result of one seed: GAASS, then (optionally) refinement, raw and canonical.
+
+    ``sign`` is the canonical calibration gain (+1, or -1 for a sensor that
+    falls as the actuator output rises): measurement = ``sign * chain(x)``.
+    """
 
     seed: int
     x_raw: np.ndarray
     x: np.ndarray
+    sign: float
     fun: float
     er_percent: float
     er_gaass_percent: float
@@ -118,6 +123,9 @@ class Identification:
         Best run's parameters in the canonical gauge (output in measurement units).
     params_mean : dict
         Canonical parameters averaged over seeds (the paper's Table 1 convention).
+    output_sign : float
+        +1, or -1 when the measurement falls as the actuator output rises;
+        the canonical chain predicts ``output_sign * measurement``.
     er_percent : float
         %e_r of the best run.
     er_mean_params_percent : float
@@ -134,6 +142,7 @@ class Identification:
     names: tuple[str, ...]
     params: dict
     params_mean: dict
+    output_sign: float
     er_percent: float
     er_mean_params_percent: float
     noise_floor_percent: float
@@ -150,8 +159,8 @@ class Identification:
         return np.array([self.params[n] for n in self.names])
 
     def spec(self) -> ChainSpec:
-        """Chain spec that simulates the canonical parameters (calibration 1, 0)."""
-        return chain_spec(self.channel, calibration=(1.0, 0.0)).with_bounds(
+        """Chain spec that simulates the canonical parameters (calibration sign, 0)."""
+        return chain_spec(self.channel, calibration=(self.output_sign, 0.0)).with_bounds(
             self.bounds, source=self.domain_source)
 
     def to_dict(self) -> dict:
@@ -164,8 +173,11 @@ class Identification:
         return {
             'channel': self.channel, 'source': self.source,
             'params': self.params, 'params_mean': self.params_mean,
-            'calibration': {'k': 1.0, 'b': 0.0, 'note': 'canonical gauge: output in '
-                            'measurement units, backlash unit slope centred on 0'},
+            'output_sign': self.output_sign,
+            'calibration': {'k': self.output_sign, 'b': 0.0,
+                            'note': 'canonical gauge: H output in measurement units '
+                            '(negated when output_sign is -1), backlash unit slope '
+                            'centred on 0'},
             'er_percent': self.er_percent,
             'er_mean_params_percent': self.er_mean_params_percent,
             'er_seeds_percent': [r.er_percent for r in self.runs],
@@ -226,8 +238,12 @@ def _run_seed(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray, measurement
         if best_fun <= good_enough or (target is not None and best_fun <= target):
             break
     k, b = spec.fit_calibration(best_x, t_s, command, measurement)
-    x = canonical_gauge(best_x, (k, b)) if k > 0 else best_x.copy()
-    return SeedRun(seed=int(seed), x_raw=best_x, x=x, fun=float(best_fun),
+    if k == 0:
+        raise IdentificationError('the best chain output does not vary: the measurement '
+                                  'shows no response to the command')
+    x = canonical_gauge(best_x, (k, b))
+    return SeedRun(seed=int(seed), x_raw=best_x, x=x, sign=output_sign((k, b)),
+                   fun=float(best_fun),
                    er_percent=float(er_percent(best_fun, measurement)), er_gaass_percent=er_ga,
                    nfev=nfev, nit=nit, best_history=history, message=message)
 
@@ -320,8 +336,13 @@ def summarise(rec: Recording, spec: ChainSpec, settings: IdentifySettings,
               runs: list[SeedRun]) -> Identification:
     """Combine seed runs into an :class:`Identification`."""
     best = min(runs, key=lambda r: r.fun)
-    canon = chain_spec(rec.channel, calibration=(1.0, 0.0))
-    xs = np.array([r.x for r in runs])
+    canon = chain_spec(rec.channel, calibration=(best.sign, 0.0))
+    warnings = []
+    same_sign = [r for r in runs if r.sign == best.sign]
+    if len(same_sign) < len(runs):
+        warnings.append(f'{len(runs) - len(same_sign)} seed(s) found the opposite sensor '
+                        'gain sign; they are left out of the mean')
+    xs = np.array([r.x for r in same_sign])
     x_mean = xs.mean(axis=0)
     try:
         y_mean = canon.simulate(x_mean, rec.t_s, rec.command)
@@ -330,8 +351,8 @@ def summarise(rec: Recording, spec: ChainSpec, settings: IdentifySettings,
         er_mean = float('nan')
     return Identification(
         channel=rec.channel, names=spec.names, params=spec.as_dict(best.x),
-        params_mean=spec.as_dict(x_mean), er_percent=best.er_percent,
+        params_mean=spec.as_dict(x_mean), output_sign=best.sign, er_percent=best.er_percent,
         er_mean_params_percent=er_mean,
         noise_floor_percent=noise_floor_percent(rec.measurement),
         runs=runs, bounds=spec.bounds, domain_source=spec.domain_source,
-        settings=settings, source=rec.source)
+        settings=settings, warnings=warnings, source=rec.source)

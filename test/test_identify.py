@@ -98,3 +98,16 @@ def test_bad_recordings_are_refused_in_one_line(simulated, mutate, error, text):
     with pytest.raises(error, match=text) as info:
         identify(Recording(t, v, y, 'position'))
     assert '\n' not in str(info.value)
+
+
+def test_negative_gain_sensor_is_identified_with_output_sign():
+    """Upstream pressure falls as the valve opens: k < 0 must still work."""
+    from conftest import simulate_channel
+
+    rec, y_true = simulate_channel('pressure')
+    flipped = Recording(rec.t_s, rec.command, 3000.0 - rec.measurement, 'pressure')
+    ident = identify(flipped, settings=IdentifySettings(seeds=(0, 1)))
+    assert ident.output_sign == -1.0
+    y_fit = ident.spec().simulate(ident.x, rec.t_s, rec.command)
+    noise_rms = np.sqrt(np.mean((rec.measurement - y_true) ** 2))
+    assert np.sqrt(np.mean((y_fit - (3000.0 - y_true)) ** 2)) < 0.35 * noise_rms
