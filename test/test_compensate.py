@@ -73,7 +73,7 @@ def test_swap_keeps_state_inside_the_new_loop():
 @pytest.mark.parametrize('values, reason', [
     ({'m_l': 1.0}, 'missing'),
     ({**dict(zip(('m_l', 'm_r', 'm_t', 'm_b', 'c_l', 'c_r', 'c_t', 'c_b', 'm_bl', 'c_bl',
-                  'c_br'), CANON)), 'c_l': 2.0}, 'c_l < c_r'),
+                  'c_br'), CANON)), 'c_l': 2.0}, 'not proper'),
     ({**dict(zip(('m_l', 'm_r', 'm_t', 'm_b', 'c_l', 'c_r', 'c_t', 'c_b', 'm_bl', 'c_bl',
                   'c_br'), CANON)), 'output_sign': 0.5}, 'output_sign'),
 ])

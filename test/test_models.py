@@ -98,7 +98,7 @@ def test_backlash_holds_inside_the_dead_band():
 
 @pytest.mark.parametrize('bad, rule', [
     ([1.0, 1.0, 1.2, 0.1, 0, 1, 10, 5], 'm_t'),
-    ([1.0, 1.0, 0.1, 0.1, 1, 0, 10, 5], 'c_l < c_r'),
+    ([1.0, 1.0, 0.1, 0.1, 1, 0, 10, 5], 'left line must stay left'),
     ([1.0, 1.0, 0.1, 0.1, 0, 1, 5, 10], 'c_t > c_b'),
     ([-1.0, 1.0, 0.1, 0.1, 0, 1, 10, 5], 'm_l'),
     ([0.714, 1.092, 0.546, 0.399, -2.623, -1.267, 6.808, 4.79], 'not proper'),
@@ -106,6 +106,15 @@ def test_backlash_holds_inside_the_dead_band():
 def test_infeasible_hysteresis_is_rejected_with_the_rule(bad, rule):
     with pytest.raises(InvalidParametersError, match=rule.split()[-1]):
         check_hysteresis(bad)
+
+
+def test_canonical_sets_may_have_c_l_above_c_r_when_the_loop_is_proper():
+    """c_l < c_r is not gauge invariant; a shifted output can swap the zero crossings."""
+    from hyst_id.gauge import affine_map_output
+    raw = np.concatenate([PAPER_H, [1.0, -0.15, 0.15]])
+    shifted = affine_map_output(raw, 1.0, -400.0)
+    assert shifted[4] > shifted[5]
+    check_hysteresis(shifted[:8])
 
 
 def nonuniform_times(n=400, seed=0):

@@ -46,6 +46,7 @@ __all__ = [
     'check_hysteresis',
     'hysteresis_feasible',
     'loop_corners',
+    'loop_is_proper',
     'initial_output',
     'hysteresis_step',
     'hysteresis_inverse_step',
@@ -57,24 +58,39 @@ HYSTERESIS_NAMES = ('m_l', 'm_r', 'm_t', 'm_b', 'c_l', 'c_r', 'c_t', 'c_b')
 
 
 @njit(cache=True, inline='always')
-def hysteresis_feasible(m_l, m_r, m_t, m_b, c_l, c_r, c_t, c_b):
-    """Return True when the parameters satisfy the paper's constraints and the loop is proper.
+def loop_is_proper(m_l, m_r, m_t, m_b, c_l, c_r, c_t, c_b):
+    """Return True when the parameters describe a proper loop (gauge invariant).
 
-    Besides the paper's constraints, the four corners must form a proper
-    quadrilateral (see :func:`loop_corners`): the left line meets the bottom
-    and the top lines before the right line does, and meets the bottom
-    before the top. The paper's constraints alone admit loops whose left and
-    right lines cross inside the band, on which H jumps and H^-1 fails.
+    Slopes ``min(m_l, m_r) > m_t, m_b > 0``, ``c_t > c_b``, and the four
+    corners form a proper quadrilateral (see :func:`loop_corners`): the left
+    line meets the bottom and the top lines before the right line does, and
+    meets the bottom before the top. These conditions survive any positive
+    rescaling and shift of the output (the gauge of ``docs/model.md``); the
+    paper's ``c_l < c_r`` does not (it compares where the lines extrapolate
+    to zero output) and is therefore only a search-space constraint
+    (:func:`hysteresis_feasible`).
     """
     m_min = min(m_l, m_r)
     if not (m_l > 0.0 and m_r > 0.0 and 0.0 < m_t < m_min and 0.0 < m_b < m_min
-            and c_l < c_r and c_t > c_b):
+            and c_t > c_b):
         return False
     v_a = (c_b + m_l * c_l) / (m_l - m_b)
     v_b = (c_b + m_r * c_r) / (m_r - m_b)
     v_c = (c_t + m_r * c_r) / (m_r - m_t)
     v_d = (c_t + m_l * c_l) / (m_l - m_t)
     return v_a < v_b and v_d < v_c and v_a < v_d and v_b < v_c
+
+
+@njit(cache=True, inline='always')
+def hysteresis_feasible(m_l, m_r, m_t, m_b, c_l, c_r, c_t, c_b):
+    """Return True for the paper's constraints (incl. ``c_l < c_r``) on a proper loop.
+
+    This is the search-space constraint of GAASS's rejecting strategy. The
+    paper's constraints alone admit loops whose left and right lines cross
+    inside the band, on which H jumps and H^-1 fails, hence
+    :func:`loop_is_proper` as well.
+    """
+    return c_l < c_r and loop_is_proper(m_l, m_r, m_t, m_b, c_l, c_r, c_t, c_b)
 
 
 @njit(cache=True, inline='always')
@@ -149,7 +165,11 @@ def loop_corners(params: np.ndarray) -> dict[str, tuple[float, float]]:
 
 
 def check_hysteresis(params: np.ndarray) -> np.ndarray:
-    """Return ``params`` as float64, or raise if they violate the constraints.
+    """Return ``params`` as float64, or raise if they do not describe a proper loop.
+
+    The checks are gauge invariant (:func:`loop_is_proper`), so they hold for
+    canonical parameter sets too; the paper's ``c_l < c_r`` is a search-space
+    constraint only and is not required here.
 
     Parameters
     ----------
@@ -170,17 +190,17 @@ def check_hysteresis(params: np.ndarray) -> np.ndarray:
         (m_l > 0 and m_r > 0, 'm_l, m_r > 0'),
         (0 < m_t < min(m_l, m_r), 'min(m_l, m_r) > m_t > 0'),
         (0 < m_b < min(m_l, m_r), 'min(m_l, m_r) > m_b > 0'),
-        (c_l < c_r, 'c_l < c_r'),
         (c_t > c_b, 'c_t > c_b'),
     )
     for ok, rule in checks:
         if not ok:
             raise InvalidParametersError(f'hysteresis parameters violate {rule}')
-    if not hysteresis_feasible(m_l, m_r, m_t, m_b, c_l, c_r, c_t, c_b):
+    if not loop_is_proper(m_l, m_r, m_t, m_b, c_l, c_r, c_t, c_b):
         corners = {k: round(v[0], 4) for k, v in loop_corners(p).items()}
         raise InvalidParametersError(
-            'hysteresis loop is not proper: the left and right lines cross inside the '
-            f'band (corner commands {corners} need A < B, D < C, A < D, B < C)')
+            'hysteresis loop is not proper: the left line must stay left of the right line '
+            f'between the bottom and top lines (corner commands {corners} need A < B, '
+            'D < C, A < D, B < C)')
     return p
 
 
