@@ -196,7 +196,7 @@ def check_hysteresis(params: np.ndarray) -> np.ndarray:
         if not ok:
             raise InvalidParametersError(f'hysteresis parameters violate {rule}')
     if not loop_is_proper(m_l, m_r, m_t, m_b, c_l, c_r, c_t, c_b):
-        corners = {k: round(v[0], 4) for k, v in loop_corners(p).items()}
+        corners = {k: round(float(v[0]), 4) for k, v in loop_corners(p).items()}
         raise InvalidParametersError(
             'hysteresis loop is not proper: the left line must stay left of the right line '
             f'between the bottom and top lines (corner commands {corners} need A < B, '

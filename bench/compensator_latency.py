@@ -1,0 +1,175 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""Compensator latency: compute time per sample, and desired -> command through DDS.
+
+1. Compute: :meth:`hyst_id.compensate.Compensator.step` with the paper's
+   hysteresis, timed sample by sample (target: median < 20 us).
+2. Loopback: the compensator node runs as its own process (own ROS domain,
+   localhost discovery); this script publishes Eq. 25 desired values at
+   100 Hz and 1 kHz and times each compensated command's arrival. Commands
+   are matched to desired values by order (both streams are reliable) and
+   checked against a local Compensator fed the same values.
+
+Usage: ``python bench/compensator_latency.py [--seconds 5] [--domain 91]``
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+
+import numpy as np
+
+
+PAPER = {'m_l': 1.01, 'm_r': 1.05, 'm_t': 0.10, 'm_b': 0.15, 'c_l': -0.25, 'c_r': 0.50,
+         'c_t': 14.0, 'c_b': 7.0, 'm_bl': 1.0, 'c_bl': -0.25, 'c_br': 0.25}
+
+
+def compute_times(n: int = 100_000) -> np.ndarray:
+    """Per-sample compute time (ns) of Compensator.step on Eq. 25 desired values."""
+    from hyst_id.compensate import CommandLimits, Compensator, InverseModel
+    comp = Compensator(InverseModel.from_mapping(PAPER), CommandLimits(4.0, 20.0), v0=9.0)
+    desired = 9.0 + np.sin(2 * np.pi * np.arange(n) * 0.01 / 12.0)
+    for d in desired[:2000]:                       # JIT / cache warm-up
+        comp.step(float(d), 0.0)
+    out = np.empty(n, dtype=np.int64)
+    clock = time.perf_counter_ns
+    for k, d in enumerate(desired.tolist()):
+        t0 = clock()
+        comp.step(d, k * 0.01)
+        out[k] = clock() - t0
+    return out
+
+
+def loopback(rate_hz: float, seconds: float, context, ref) -> dict:
+    """Publish desired values at ``rate_hz`` and time the compensated commands.
+
+    ``ref`` is a local Compensator that has seen everything the node has.
+    """
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.node import Node
+    from std_msgs.msg import Float64
+
+    from hyst_id.nodes import COMMAND_QOS
+
+    node = Node(f'latency_{int(rate_hz)}', context=context)
+    pub = node.create_publisher(Float64, '/hyst_id/desired', COMMAND_QOS)
+    recv: list[tuple[int, float]] = []
+    node.create_subscription(Float64, '/hyst_id/command',
+                             lambda m: recv.append((time.monotonic_ns(), m.data)), COMMAND_QOS)
+    ex = SingleThreadedExecutor(context=context)
+    ex.add_node(node)
+    spin = threading.Event()
+
+    def spinner() -> None:
+        while not spin.is_set():
+            ex.spin_once(timeout_sec=0.01)
+
+    thread = threading.Thread(target=spinner, daemon=True)
+    thread.start()
+    deadline = time.monotonic() + 20.0
+    while (pub.get_subscription_count() < 1 or node.count_publishers('/hyst_id/command') < 1) \
+            and time.monotonic() < deadline:
+        time.sleep(0.05)
+    time.sleep(0.5)
+    n = int(rate_hz * seconds)
+    period = 1.0 / rate_hz
+    desired = 9.0 + np.sin(2 * np.pi * np.arange(n) * period / 12.0)
+    sent = np.empty(n, dtype=np.int64)
+    start = time.monotonic()
+    for k in range(n):
+        due = start + k * period
+        while True:
+            now = time.monotonic()
+            if now >= due:
+                break
+            time.sleep(min(due - now, 0.0005))
+        sent[k] = time.monotonic_ns()
+        pub.publish(Float64(data=float(desired[k])))
+    time.sleep(1.0)
+    spin.set()
+    thread.join(2.0)
+    ex.remove_node(node)
+    node.destroy_node()
+    # Match each command to the desired sample it answers: the next sample, in order,
+    # whose locally compensated value it equals (a lost input changes the inverse's
+    # output only around a reversal, so the search resynchronises).
+    expect = np.array([ref.step(float(d)) for d in desired])
+    lat_us, unmatched, j = [], 0, 0
+    for t_ns, value in recv:
+        hits = np.flatnonzero(np.abs(expect[j:j + 2000] - value) <= 1e-9)
+        if hits.size == 0:
+            unmatched += 1
+            continue
+        k = j + int(hits[0])
+        lat_us.append((t_ns - sent[k]) / 1e3)
+        j = k + 1
+    lat = np.array(lat_us) if lat_us else np.array([np.nan])
+    return {'rate_hz': rate_hz, 'sent': n, 'received': len(recv), 'lost': n - len(recv),
+            'median_us': float(np.median(lat)), 'p99_us': float(np.percentile(lat, 99)),
+            'max_us': float(np.max(lat)), 'mismatched': unmatched}
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run both benchmarks and print the table."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument('--seconds', type=float, default=5.0, help='length of each DDS run')
+    parser.add_argument('--domain', type=int, default=91, help='ROS_DOMAIN_ID to use')
+    args = parser.parse_args(argv)
+
+    ns = compute_times()
+    print('compute: Compensator.step (paper H, B), per sample')
+    print(f'  median {np.median(ns) / 1e3:7.2f} us   p99 {np.percentile(ns, 99) / 1e3:7.2f} us'
+          f'   (target median < 20 us: {"met" if np.median(ns) < 20e3 else "NOT met"})')
+
+    os.environ['ROS_DOMAIN_ID'] = str(args.domain)
+    os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+    overrides = [a for k, v in PAPER.items() for a in ('-p', f'{k}:={v!r}')]
+    import rclpy
+    from hyst_id.compensate import CommandLimits, Compensator, InverseModel
+    context = rclpy.Context()
+    rclpy.init(context=context)
+    rows = []
+    try:
+        for rate in (100.0, 1000.0):      # a fresh compensator process per rate
+            comp = subprocess.Popen([sys.executable, '-m', 'hyst_id.nodes.compensator',
+                                     '--ros-args', *overrides, '-p', 'max_rate_per_s:=0.0'],
+                                    stdout=subprocess.DEVNULL, stderr=subprocess.STDOUT)
+            try:
+                ref = Compensator(InverseModel.from_mapping(PAPER), CommandLimits(4.0, 20.0),
+                                  v0=9.0)
+                rows.append(loopback(rate, args.seconds, context, ref))
+            finally:
+                comp.send_signal(signal.SIGINT)
+                comp.wait(15)
+    finally:
+        context.try_shutdown()
+    print('\nloopback through DDS: desired -> compensator node -> command '
+          '(separate processes, localhost)')
+    print(f'  {"rate":>7} {"sent":>6} {"lost":>5} {"median":>9} {"p99":>9} {"max":>9} '
+          f'{"unmatched":>9}')
+    for r in rows:
+        print(f'  {r["rate_hz"]:5.0f}Hz {r["sent"]:6d} {r["lost"]:5d} {r["median_us"]:7.0f}us '
+              f'{r["p99_us"]:7.0f}us {r["max_us"]:7.0f}us {r["mismatched"]:9d}')
+    return 0
+
+
+if __name__ == '__main__':
+    raise SystemExit(main())

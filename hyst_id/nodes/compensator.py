@@ -1,0 +1,284 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""Compensator node: desired output -> B^-1 -> H^-1 -> command, sample by sample.
+
+Parameters ``m_l ... c_b`` (hysteresis) and ``m_bl c_bl c_br`` (backlash),
+canonical gauge, are ordinary ROS parameters. A change is validated as a
+whole set: a set violating the loop constraints is rejected with the reason
+and the last good set stays in use. Unset parameters are ``.nan``; while no
+complete valid set exists the node passes the desired value through (within
+the command limits) and says so in its log and on ``/diagnostics``.
+
+Coupled parameters (``c_l < c_r``...) must change together: use
+``set_parameters_atomically`` (the identifier does), a params file, or the
+latched identified-parameters topic, which the node also follows.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+import json
+import math
+import statistics
+import time
+from typing import Any
+
+import rclpy
+from rclpy.executors import ExternalShutdownException
+from rclpy.parameter import Parameter
+from std_msgs.msg import Float64, String
+
+from hyst_id.compensate import CommandLimits, Compensator as CoreCompensator, InverseModel
+from hyst_id.errors import HystIdError, InvalidParametersError
+from hyst_id.io.params_file import COMPENSATOR_NAMES
+from hyst_id.io.recording import CHANNELS
+from hyst_id.nodes import (COMMAND_QOS, DESIRED_TOPIC, HystNode, IDENTIFIED_PARAMS_TOPIC, init_ros,
+                           LATCHED_QOS, Param, topic_params)
+
+__all__ = ['Compensator', 'PARAMS', 'main']
+
+_NAN = math.nan
+_MODEL_KEYS = set(COMPENSATOR_NAMES) | {'output_sign'}
+_DESCRIPTIONS = {
+    'm_l': 'hysteresis left-line slope', 'm_r': 'hysteresis right-line slope',
+    'm_t': 'hysteresis top-line slope', 'm_b': 'hysteresis bottom-line slope',
+    'c_l': 'hysteresis left-line crossing', 'c_r': 'hysteresis right-line crossing',
+    'c_t': 'hysteresis top-line intercept', 'c_b': 'hysteresis bottom-line intercept',
+    'm_bl': 'backlash slope (1 in the canonical gauge)', 'c_bl': 'backlash left crossing',
+    'c_br': 'backlash right crossing',
+}
+_UNITS = {'m_l': 'out/mA', 'm_r': 'out/mA', 'm_t': 'out/mA', 'm_b': 'out/mA', 'c_l': 'mA',
+          'c_r': 'mA', 'c_t': 'out', 'c_b': 'out', 'm_bl': '1', 'c_bl': 'out', 'c_br': 'out'}
+
+PARAMS = [
+    Param('channel', 'position', 'measured channel the model was identified on; '
+          'identified-parameter messages of another channel are ignored', choices=CHANNELS),
+    *[Param(n, _NAN, _DESCRIPTIONS[n] + '; .nan = unset', unit=_UNITS[n])
+      for n in COMPENSATOR_NAMES],
+    Param('output_sign', 1.0, 'sign of the sensor gain (canonical calibration): -1 when the '
+          'measurement falls as the actuator output rises', low=-1.0, high=1.0),
+    Param('er_percent', _NAN, '%e_r (Eq. 7) of the identification; information only'),
+    Param('min_command', 4.0, 'lowest command sent', low=-1e6, high=1e6, unit='mA'),
+    Param('max_command', 20.0, 'highest command sent', low=-1e6, high=1e6, unit='mA'),
+    Param('max_rate_per_s', 0.0, 'largest command change per second; 0 = unlimited',
+          low=0.0, high=1e9, unit='mA/s'),
+    Param('initial_command', 9.0, 'command the actuator holds before the first sample',
+          low=-1e6, high=1e6, unit='mA'),
+    Param('follow_identified_params', True,
+          'apply parameter sets published on the identified-parameters topic'),
+    Param('diagnostics_period_s', 1.0, 'period of the /diagnostics status', low=0.05,
+          high=3600.0, unit='s'),
+    *topic_params(('command_topic',)),
+    Param('topics.desired_topic', DESIRED_TOPIC, 'desired output topic (std_msgs/Float64)',
+          read_only=True),
+    Param('topics.identified_params_topic', IDENTIFIED_PARAMS_TOPIC,
+          'latched identified parameters (std_msgs/String, JSON)', read_only=True),
+]
+
+
+def _limits(values: dict[str, Any]) -> CommandLimits:
+    rate = values['max_rate_per_s']
+    return CommandLimits(min_command=values['min_command'], max_command=values['max_command'],
+                         max_rate_per_s=rate if rate > 0 else math.inf)
+
+
+def _model_state(values: dict[str, Any]) -> tuple[str, InverseModel | None, list[str]]:
+    """Classify the model parameters: ('none'|'incomplete'|'valid', model, unset names)."""
+    unset = [n for n in COMPENSATOR_NAMES if math.isnan(values[n])]
+    if len(unset) == len(COMPENSATOR_NAMES):
+        return 'none', None, unset
+    if unset:
+        return 'incomplete', None, unset
+    mapping = {n: values[n] for n in COMPENSATOR_NAMES + ('output_sign',)}
+    return 'valid', InverseModel.from_mapping(mapping), []
+
+
+class Compensator(HystNode):
+    """Inverse hysteresis + backlash compensation between desired and command topics."""
+
+    def __init__(self, **kwargs: Any) -> None:
+        super().__init__('compensator', PARAMS, **kwargs)
+        values = self.param_values()
+        kind, model, unset = _model_state(values)
+        self._comp = CoreCompensator(model, _limits(values), v0=values['initial_command'])
+        self._source = 'params' if model is not None else ''
+        self._n = 0
+        self._step_ns: deque[int] = deque(maxlen=2000)
+        self._cmd_pub = self.create_publisher(Float64, self.p('topics.command_topic'),
+                                              COMMAND_QOS)
+        self.create_subscription(Float64, self.p('topics.desired_topic'), self._on_desired,
+                                 COMMAND_QOS)
+        self.create_subscription(String, self.p('topics.identified_params_topic'),
+                                 self._on_identified, LATCHED_QOS)
+        self._diag_timer = self.create_timer(values['diagnostics_period_s'],
+                                             self._publish_status)
+        log = self.get_logger()
+        log.info(f'compensating {self.p("topics.desired_topic")} -> '
+                 f'{self.p("topics.command_topic")}, command in [{values["min_command"]:g}, '
+                 f'{values["max_command"]:g}] mA')
+        if model is not None:
+            log.info(f'model from parameters: {self._describe(values)}')
+        elif kind == 'incomplete':
+            log.warning(f'parameter set incomplete (unset: {", ".join(unset)}): passing the '
+                        'desired value through unchanged')
+        else:
+            log.warning('no parameter set yet: passing the desired value through unchanged '
+                        'until one arrives (parameters, identified-params topic)')
+
+    # ---------------------------------------------------------------- params
+    def validate_params(self, values: dict[str, Any], changed: set[str]) -> str | None:
+        if not values['min_command'] < values['max_command']:
+            return (f'min_command ({values["min_command"]:g}) must be < max_command '
+                    f'({values["max_command"]:g})')
+        if values['output_sign'] not in (1.0, -1.0):
+            return f'output_sign must be 1.0 or -1.0; got {values["output_sign"]!r}'
+        if changed & _MODEL_KEYS:
+            inf = [n for n in COMPENSATOR_NAMES if math.isinf(values[n])]
+            if inf:
+                return f'{", ".join(inf)} must be finite (or .nan for unset)'
+            try:
+                kind, _, unset = _model_state(values)
+            except InvalidParametersError as exc:
+                return f'{exc}; keeping the last good set'
+            if kind == 'incomplete' and getattr(self, '_comp', None) is not None \
+                    and self._comp.model is not None:
+                return (f'incomplete set (unset: {", ".join(unset)}): give all 11 '
+                        'parameters together; keeping the last good set')
+        return None
+
+    def apply_params(self, values: dict[str, Any], changed: set[str]) -> None:
+        if not hasattr(self, '_comp'):
+            return
+        if changed & {'min_command', 'max_command', 'max_rate_per_s'}:
+            self._comp.limits = _limits(values)
+        if 'diagnostics_period_s' in changed:
+            self._diag_timer.cancel()
+            self.destroy_timer(self._diag_timer)
+            self._diag_timer = self.create_timer(values['diagnostics_period_s'],
+                                                 self._publish_status)
+        if changed & _MODEL_KEYS:
+            kind, model, unset = _model_state(values)
+            if model is not None and model == self._comp.model:
+                self._source_hint = ''
+                return
+            self._comp.set_model(model)
+            if model is not None:
+                self._source = self._source_hint or 'set_parameters'
+                self.get_logger().info(f'applied parameter set from {self._source}: '
+                                       f'{self._describe(values)}')
+            elif kind == 'none':
+                self._source = ''
+                self.get_logger().warning('parameter set cleared: passing the desired value '
+                                          'through unchanged')
+            else:
+                self.get_logger().info(f'parameter set incomplete (unset: {", ".join(unset)})')
+        self._source_hint = ''
+
+    _source_hint = ''
+
+    @staticmethod
+    def _describe(values: dict[str, Any]) -> str:
+        er = values.get('er_percent', _NAN)
+        head = f'channel {values["channel"]}' + ('' if math.isnan(er) else f', %e_r {er:.3g}')
+        if values.get('output_sign', 1.0) < 0:
+            head += ', output_sign -1'
+        return head + ': ' + ', '.join(f'{n}={values[n]:.6g}' for n in COMPENSATOR_NAMES)
+
+    # ------------------------------------------------------------- callbacks
+    def _on_desired(self, msg: Float64) -> None:
+        t_s = self.get_clock().now().nanoseconds * 1e-9
+        t0 = time.perf_counter_ns()
+        v = self._comp.step(float(msg.data), t_s)
+        self._step_ns.append(time.perf_counter_ns() - t0)
+        self._cmd_pub.publish(Float64(data=v))
+        self._n += 1
+        if not math.isfinite(msg.data):
+            self.get_logger().warning('non-finite desired value: holding the last command',
+                                      throttle_duration_sec=5.0)
+
+    def _on_identified(self, msg: String) -> None:
+        if not self.p('follow_identified_params'):
+            return
+        log = self.get_logger()
+        try:
+            doc = json.loads(msg.data)
+            params = doc.get('compensator_params') or doc.get('params', doc)
+            channel = str(doc.get('channel', params.get('channel', '')))
+            values = {n: float(params[n]) for n in COMPENSATOR_NAMES}
+            values['output_sign'] = float(doc.get('output_sign', params.get('output_sign', 1.0)))
+            er = float(doc.get('compensator_er_percent', doc.get('er_percent', _NAN)))
+        except (ValueError, TypeError, KeyError, AttributeError) as exc:
+            log.warning(f'ignored identified parameters: not the expected JSON ({exc})')
+            return
+        if channel != self.p('channel'):
+            log.info(f'ignored identified parameters of channel {channel!r} (this compensator '
+                     f'is for {self.p("channel")!r})')
+            return
+        current = self.param_values()
+        if all(current[n] == values[n] for n in values):
+            return
+        self._source_hint = 'identified-params topic'
+        result = self.set_parameters_atomically(
+            [Parameter(n, value=v) for n, v in values.items()]
+            + [Parameter('er_percent', value=er)])
+        self._source_hint = ''
+        if not result.successful:
+            log.warning(f'identified parameters rejected: {result.reason}')
+
+    def _publish_status(self) -> None:
+        model = self._comp.model
+        steps = list(self._step_ns)
+        median_us = statistics.median(steps) / 1e3 if steps else _NAN
+        values = {'channel': self.p('channel'), 'samples': self._n,
+                  'compute_median_us': median_us, 'source': self._source or 'none',
+                  'er_percent': self.p('er_percent'), 'command': self._comp.state[0]}
+        if model is None:
+            self.publish_diagnostics(1, 'no valid parameter set: passing the desired value '
+                                     'through unchanged', values)
+        else:
+            self.publish_diagnostics(0, f'compensating ({self.p("channel")})', values)
+
+    @property
+    def model(self) -> InverseModel | None:
+        """The parameter set in use (None: pass-through)."""
+        return self._comp.model
+
+    def step(self, desired: float, t_s: float | None = None) -> float:
+        """Compensate one sample without ROS (tests, benchmarks)."""
+        return self._comp.step(desired, t_s)
+
+
+def main(args: list[str] | None = None) -> int:
+    """Run the compensator node until Ctrl-C / SIGTERM."""
+    if not init_ros(args, 'compensator'):
+        return 2
+    node = None
+    try:
+        node = Compensator()
+        rclpy.spin(node)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    except HystIdError as exc:
+        rclpy.logging.get_logger('compensator').error(str(exc))
+        return 2
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+    return 0
+
+
+if __name__ == '__main__':
+    raise SystemExit(main())

@@ -1,0 +1,206 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""Recorder node: logs a list of topics to a rosbag2 MCAP bag (hyst_id.io.bag).
+
+Each configured topic is subscribed once it has a publisher: its type comes
+from the ROS graph (imported with importlib), its QoS is adapted to the
+publishers (best effort if any publisher is, transient local if all are),
+and messages are written as received, still serialised (``raw=True``).
+
+Log time of a message is its *source timestamp* (when the publisher sent
+it, from the middleware), not when the recorder got it: so a position
+stamped right after the command that caused it is never logged before that
+command, however late delivery was, and readers pairing streams by stamp
+(``hyst_id.io.readers``) pair them as they happened. The bag is finalised
+on Ctrl-C / SIGTERM (the summary and ``metadata.yaml`` are written).
+"""
+
+from __future__ import annotations
+
+import datetime
+from pathlib import Path
+import threading
+from typing import Any
+
+import rclpy
+from rclpy.executors import ExternalShutdownException
+from rclpy.qos import (DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy)
+
+from hyst_id.errors import ConfigError, HystIdError
+from hyst_id.io.bag import BagWriter
+from hyst_id.nodes import (DESIRED_TOPIC, HystNode, IDENTIFIED_PARAMS_TOPIC, init_ros,
+                           message_class, Param, topic_params)
+
+__all__ = ['PARAMS', 'Recorder', 'default_bag_name', 'main']
+
+_DEFAULT_TOPICS = [p.default for p in topic_params()] + [DESIRED_TOPIC,
+                                                         IDENTIFIED_PARAMS_TOPIC]
+
+PARAMS = [
+    Param('output', '', "bag directory to create; '' = hyst_id_<date-time> in the working "
+          'directory', read_only=True),
+    Param('topics', _DEFAULT_TOPICS, 'topics to record', read_only=True),
+    Param('discovery_period_s', 0.1, 'how often to look for the publishers of missing '
+          'topics', low=0.01, high=60.0, unit='s', read_only=True),
+    Param('flush_period_s', 1.0, 'write the pending chunk at least this often', low=0.05,
+          high=3600.0, unit='s', read_only=True),
+    Param('chunk_size', 65536, 'largest MCAP chunk before it is written', low=1024,
+          high=1048576, unit='bytes', read_only=True),
+]
+
+
+def default_bag_name() -> str:
+    """Return ``hyst_id_YYYY_MM_DD-HH_MM_SS`` (rosbag2's naming)."""
+    return datetime.datetime.now().strftime('hyst_id_%Y_%m_%d-%H_%M_%S')
+
+
+def _qos_for(infos: list) -> QoSProfile:
+    best_effort = any(i.qos_profile.reliability == ReliabilityPolicy.BEST_EFFORT
+                      for i in infos)
+    latched = bool(infos) and all(
+        i.qos_profile.durability == DurabilityPolicy.TRANSIENT_LOCAL for i in infos)
+    return QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1000,
+                      reliability=(ReliabilityPolicy.BEST_EFFORT if best_effort
+                                   else ReliabilityPolicy.RELIABLE),
+                      durability=(DurabilityPolicy.TRANSIENT_LOCAL if latched
+                                  else DurabilityPolicy.VOLATILE))
+
+
+class Recorder(HystNode):
+    """Write the configured topics into an MCAP bag until shut down."""
+
+    def __init__(self, **kwargs: Any) -> None:
+        super().__init__('recorder', PARAMS, **kwargs)
+        topics = [t for t in self.p('topics') if t]
+        if not topics:
+            raise ConfigError('recorder: no topics to record')
+        self._wanted = list(dict.fromkeys(topics))
+        self.path = Path(self.p('output') or default_bag_name()).expanduser()
+        self._lock = threading.Lock()
+        self._writer = BagWriter(self.path, chunk_size=self.p('chunk_size')).open()
+        self._subs: dict[str, Any] = {}
+        self.counts: dict[str, int] = {}
+        self.create_timer(self.p('discovery_period_s'), self._discover)
+        self.create_timer(self.p('flush_period_s'), self._flush)
+        self.create_timer(1.0, self._status)
+        self.get_logger().info(f'recording {len(self._wanted)} topic(s) to {self.path}: '
+                               f'{", ".join(self._wanted)}')
+        self._discover()
+
+    @property
+    def subscribed(self) -> list[str]:
+        """Topics subscribed so far."""
+        return list(self._subs)
+
+    def _discover(self) -> None:
+        missing = [t for t in self._wanted if t not in self._subs]
+        if not missing or self._writer is None:
+            return
+        graph = dict(self.get_topic_names_and_types())
+        for topic in missing:
+            types = graph.get(topic)
+            if not types:
+                continue
+            infos = self.get_publishers_info_by_topic(topic)
+            if not infos:
+                continue
+            msgtype = types[0]
+            if len(types) > 1:
+                self.get_logger().warning(f'{topic} has several types {types}; recording '
+                                          f'{msgtype}')
+            try:
+                cls = message_class(msgtype)
+                with self._lock:
+                    self._writer.add_topic(topic, msgtype)
+            except (ConfigError, ValueError) as exc:
+                self.get_logger().error(f'cannot record {topic}: {exc}')
+                self._wanted.remove(topic)
+                continue
+            qos = _qos_for(infos)
+            self._subs[topic] = self.create_subscription(
+                cls, topic, lambda data, info, t=topic: self._on_message(t, data, info), qos,
+                raw=True)
+            self.counts[topic] = 0
+            self.get_logger().info(f'recording {topic} ({msgtype}, '
+                                   f'{qos.reliability.name.lower()})')
+
+    def _on_message(self, topic: str, data: bytes, info: dict) -> None:
+        t_ns = int(info.get('source_timestamp') or 0) or int(
+            info.get('received_timestamp') or 0) or self.get_clock().now().nanoseconds
+        with self._lock:
+            if self._writer is None:
+                return
+            self._writer.write(topic, t_ns, data)
+            self.counts[topic] += 1
+
+    def _flush(self) -> None:
+        with self._lock:
+            if self._writer is not None:
+                self._writer.flush()
+
+    def _status(self) -> None:
+        total = sum(self.counts.values())
+        missing = [t for t in self._wanted if t not in self._subs]
+        self.publish_diagnostics(0 if not missing else 1,
+                                 f'recording to {self.path}: {total} messages'
+                                 + (f'; waiting for {", ".join(missing)}' if missing else ''),
+                                 {'messages': total, 'path': str(self.path)})
+
+    def close(self) -> None:
+        """Finalise the bag (summary, metadata.yaml); idempotent."""
+        if not hasattr(self, '_writer'):    # __init__ failed before the bag was opened
+            return
+        with self._lock:
+            writer, self._writer = self._writer, None
+        if writer is not None:
+            writer.close()
+            total = sum(self.counts.values())
+            detail = ', '.join(f'{t} {n}' for t, n in self.counts.items())
+            # after SIGTERM the context (and the node's /rosout publisher) is gone: log
+            # through a logger that is not bound to /rosout
+            logger = self.get_logger() if self.context.ok() else rclpy.logging.get_logger(
+                f'{self.get_name()}.bag')
+            logger.info(f'closed {self.path}: {total} messages ({detail})')
+
+    def destroy_node(self) -> None:
+        """Close the bag, then the node."""
+        try:
+            self.close()
+        finally:
+            super().destroy_node()
+
+
+def main(args: list[str] | None = None) -> int:
+    """Record until Ctrl-C / SIGTERM, then finalise the bag."""
+    if not init_ros(args, 'recorder'):
+        return 2
+    node = None
+    try:
+        node = Recorder()
+        rclpy.spin(node)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    except HystIdError as exc:
+        rclpy.logging.get_logger('recorder').error(str(exc))
+        return 2
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+    return 0
+
+
+if __name__ == '__main__':
+    raise SystemExit(main())
