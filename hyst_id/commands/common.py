@@ -58,6 +58,9 @@ def add_settings_arguments(parser: argparse.ArgumentParser) -> None:
     g.add_argument('--workers', type=int, default=0, help='processes (0: one per core)')
     g.add_argument('--gaass-only', action='store_true',
                    help='no refinement after GAASS (fidelity to the paper)')
+    g.add_argument('--restarts', type=int, default=4,
+                   help='extra GAASS runs per seed while %%e_r stays above 1.05 x the '
+                   'noise floor (default 4; 0 = one run per seed)')
     g.add_argument('--domains', default='auto', metavar='auto|paper|YAML',
                    help="search domains: derived from the data (auto), the paper's "
                    'preset, or a YAML mapping name: [low, high]')
@@ -80,12 +83,14 @@ def load_recording(args: argparse.Namespace) -> Recording:
 
 def make_settings(args: argparse.Namespace) -> IdentifySettings:
     """GAASS settings from the command line."""
-    if args.seeds < 1 or args.pop_size < 2 or args.generations < 1:
-        raise ConfigError('need --seeds >= 1, --pop-size >= 2 and --generations >= 1')
+    if args.seeds < 1 or args.pop_size < 2 or args.generations < 1 or args.restarts < 0:
+        raise ConfigError('need --seeds >= 1, --pop-size >= 2, --generations >= 1 and '
+                          '--restarts >= 0')
     return IdentifySettings(
         pop_size=args.pop_size, maxiter=args.generations, c=args.c, xi=args.xi,
         seeds=tuple(range(args.seed_offset, args.seed_offset + args.seeds)),
-        workers=args.workers, refine=not args.gaass_only, er_bound_percent=args.er_bound)
+        workers=args.workers, refine=not args.gaass_only, restarts=args.restarts,
+        er_bound_percent=args.er_bound)
 
 
 def make_spec(args: argparse.Namespace, rec: Recording) -> ChainSpec:
