@@ -19,8 +19,12 @@
 2. Loopback: the compensator node runs as its own process (own ROS domain,
    localhost discovery); this script publishes Eq. 25 desired values at
    100 Hz and 1 kHz and times each compensated command's arrival. Commands
-   are matched to desired values by order (both streams are reliable) and
-   checked against a local Compensator fed the same values.
+   are matched to desired values by order (both streams are reliable,
+   keep-all: ``hyst_id.nodes.COMMAND_QOS``; with the former keep-last depth
+   100, 280 of 5000 were lost at 1 kHz under load) and checked against a
+   local Compensator fed the same values.
+
+``bench/compensator_load.py`` adds parameter updates mid-stream (60 s).
 
 Usage: ``python bench/compensator_latency.py [--seconds 5] [--domain 91]``
 """

@@ -41,13 +41,14 @@ from hyst_id.io.bag import iter_bag_messages, write_recording_bag  # noqa: E402
 from hyst_id.io.params_file import (COMPENSATOR_NAMES, read_compensator_params,  # noqa: E402
                                     write_compensator_params)
 from hyst_id.io.recording import Recording  # noqa: E402
+from hyst_id.live import pair_streams  # noqa: E402
 from hyst_id.nodes import LATCHED_QOS  # noqa: E402
 from hyst_id.nodes.actuator_driver import (ActuatorDriver, PAPER_BACKLASH,  # noqa: E402
                                            PAPER_HYSTERESIS, SimulatedActuator)
 from hyst_id.nodes.bringup import control_error_percent  # noqa: E402
 from hyst_id.nodes.compensator import Compensator  # noqa: E402
 from hyst_id.nodes.excitation import Excitation  # noqa: E402
-from hyst_id.nodes.identifier import Identifier, pair_streams  # noqa: E402
+from hyst_id.nodes.identifier import Identifier  # noqa: E402
 from hyst_id.nodes.pipeline_sim import PipelineSim  # noqa: E402
 from hyst_id.nodes.recorder import Recorder  # noqa: E402
 from hyst_id.nodes.replay import Replay  # noqa: E402

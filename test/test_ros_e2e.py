@@ -41,9 +41,9 @@ from rclpy.qos import QoSProfile, ReliabilityPolicy  # noqa: E402
 from sensor_msgs.msg import JointState  # noqa: E402
 from std_msgs.msg import Float64, String  # noqa: E402
 
+from hyst_id.live import SampleBuffer  # noqa: E402
 from hyst_id.nodes import COMMAND_QOS, LATCHED_QOS, stamp_ns  # noqa: E402
 from hyst_id.nodes.bringup import control_error_percent  # noqa: E402
-from hyst_id.nodes.identifier import SampleBuffer  # noqa: E402
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
@@ -222,10 +222,17 @@ def test_live_pipeline_then_replay_agrees_with_cli(ros_domain, tmp_path):
         assert graph.wait_exit('replay', 60.0) == 0, graph.log('replay')
         replayed = obs.wait_doc(2, 90.0)
         cli_json = tmp_path / 'cli.json'
+        # The replayed identifier times both streams by the replay's publish times, i.e.
+        # the bag's log times; the CLI is told to do the same (by default it times the
+        # position by its header stamp, which differs from the log time when the actuator
+        # published late, by more than a command period on a loaded machine).
+        log_stamps = tmp_path / 'log_stamps.yaml'
+        log_stamps.write_text('topics:\n  stamp_source: log\n')
         cli = subprocess.run(
             [sys.executable, '-m', 'hyst_id.cli', 'identify', str(bag), '--channel', 'position',
-             '--seeds', '2', '--generations', '100', '--workers', '1', '--domains', 'paper',
-             '--quiet', '--json', str(cli_json)], capture_output=True, text=True, timeout=300)
+             '--params', str(log_stamps), '--seeds', '2', '--generations', '100', '--workers',
+             '1', '--domains', 'paper', '--quiet', '--json', str(cli_json)],
+            capture_output=True, text=True, timeout=300)
         assert cli.returncode == 0, cli.stderr
         ref = json.loads(cli_json.read_text())
         print(f'replay identification: %e_r {replayed["er_percent"]:.6f}, '

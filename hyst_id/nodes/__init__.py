@@ -23,7 +23,14 @@ QoS per stream:
 
 * sensor data (position, pressure, flow): ``qos_profile_sensor_data``
   (best effort, depth 5);
-* commands (command, desired): reliable, volatile, depth 100;
+* commands (command, desired): reliable, volatile, **keep all**: a
+  subscriber that falls behind never loses a command silently. Its unread
+  samples wait in its reader cache (Fast DDS: up to 5000, i.e. a 5 s stall
+  at 1 kHz); beyond that the publisher blocks for up to the writer's
+  ``max_blocking_time`` (100 ms) and then ``publish`` fails with an error
+  (:func:`try_publish` turns that into a count the node reports). A
+  keep-last queue would instead overwrite the oldest unread command without
+  telling anyone (a depth-100 queue lost 280 of 5000 commands at 1 kHz);
 * identified parameters: reliable, transient local, depth 1 (latched);
 * ``/diagnostics``: reliable, depth 10.
 """
@@ -34,15 +41,19 @@ from dataclasses import dataclass
 import importlib
 import math
 import sys
+import time
 from typing import Any, Iterable, Mapping, Sequence
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from rcl_interfaces.msg import (FloatingPointRange, IntegerRange, ParameterDescriptor,
                                 SetParametersResult)
+from rcl_interfaces.srv import SetParametersAtomically
 import rclpy
 from rclpy.exceptions import (InvalidParameterTypeException, InvalidParameterValueException,
                               ParameterException)
+from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.node import Node
+from rclpy.parameter import Parameter
 from rclpy.qos import (DurabilityPolicy, HistoryPolicy, qos_profile_sensor_data, QoSProfile,
                        ReliabilityPolicy)
 
@@ -52,8 +63,10 @@ from hyst_id.io.recording import CHANNELS
 
 __all__ = [
     'COMMAND_QOS', 'DESIRED_TOPIC', 'DIAGNOSTICS_QOS', 'DIAGNOSTICS_TOPIC', 'HystNode',
-    'IDENTIFIED_PARAMS_TOPIC', 'LATCHED_QOS', 'Param', 'SENSOR_QOS', 'TOPIC_KEYS',
-    'diagnostic_array', 'init_ros', 'message_class', 'stamp_ns', 'topic_params',
+    'IDENTIFIED_PARAMS_TOPIC', 'LATCHED_QOS', 'Param', 'ParameterPusher', 'SENSOR_QOS',
+    'TOPIC_KEYS',
+    'diagnostic_array', 'field_params', 'init_ros', 'message_class', 'source_time_ns',
+    'stamp_ns', 'topic_params', 'try_publish',
 ]
 
 #: Desired output fed to the compensator (std_msgs/Float64).
@@ -64,7 +77,7 @@ IDENTIFIED_PARAMS_TOPIC = '/hyst_id/identified_params'
 DIAGNOSTICS_TOPIC = '/diagnostics'
 
 SENSOR_QOS = qos_profile_sensor_data
-COMMAND_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=100,
+COMMAND_QOS = QoSProfile(history=HistoryPolicy.KEEP_ALL,
                          reliability=ReliabilityPolicy.RELIABLE,
                          durability=DurabilityPolicy.VOLATILE)
 LATCHED_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1,
@@ -74,6 +87,7 @@ DIAGNOSTICS_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=10,
                              reliability=ReliabilityPolicy.RELIABLE,
                              durability=DurabilityPolicy.VOLATILE)
 
+_RCLError = _rclpy.RCLError
 _TYPE_NAMES = {bool: 'a bool', int: 'an integer', float: 'a double', str: 'a string',
                list: 'an array'}
 
@@ -143,6 +157,19 @@ def topic_params(keys: Iterable[str] = TOPIC_KEYS) -> list[Param]:
     return out
 
 
+def field_params() -> list[Param]:
+    """Read-only ``topics.command_field`` and ``topics.<channel>_type`` / ``_field``."""
+    out = [Param('topics.command_field', TopicConfig().command_field,
+                 'field of the command message', read_only=True)]
+    for ch in CHANNELS:
+        cfg = TopicConfig.for_channel(ch)
+        out += [Param(f'topics.{ch}_type', cfg.measurement_type, f'message type of {ch}',
+                      read_only=True),
+                Param(f'topics.{ch}_field', cfg.measurement_field, f'field of the {ch} message',
+                      read_only=True)]
+    return out
+
+
 def message_class(type_name: str) -> type:
     """Import a message class from ``pkg/msg/Name`` (or ``pkg/Name``)."""
     parts = [p for p in str(type_name).split('/') if p]
@@ -165,6 +192,27 @@ def init_ros(args: list[str] | None, name: str) -> bool:
         print(f'{name}: error: {_first_line(exc)}', file=sys.stderr)
         return False
     return True
+
+
+def try_publish(publisher: Any, msg: Any) -> bool:
+    """Publish ``msg``; return False instead of raising when the middleware refuses it.
+
+    With :data:`COMMAND_QOS` (reliable, keep all) ``publish`` blocks while a
+    subscriber's reader cache is full and fails after the writer's
+    ``max_blocking_time``; the caller counts and reports the failure (or
+    retries) instead of dying in a callback.
+    """
+    try:
+        publisher.publish(msg)
+    except _RCLError:
+        return False
+    return True
+
+
+def source_time_ns(node: Node, info: Mapping[str, Any]) -> int:
+    """A message's source timestamp (from the middleware), else its receive time, else now."""
+    return int(info.get('source_timestamp') or 0) or int(
+        info.get('received_timestamp') or 0) or node.get_clock().now().nanoseconds
 
 
 def stamp_ns(stamp: Any) -> int:
@@ -214,6 +262,8 @@ class HystNode(Node):
         super().__init__(node_name, **kwargs)
         self._param_table = {p.name: p for p in params}
         self._diag_pub = None
+        #: Parameter changes rejected since the start.
+        self.rejected_updates = 0
         defaults = dict(defaults or {})
         unknown = set(defaults) - set(self._param_table)
         if unknown:
@@ -274,6 +324,7 @@ class HystNode(Node):
         except Exception as exc:  # noqa: BLE001 - a bad value must never kill the node
             reason = f'{type(exc).__name__}: {_first_line(exc)}'
         if reason:
+            self.rejected_updates += 1
             self.get_logger().warning(f'rejected parameter change '
                                       f'{", ".join(sorted(changed))}: {reason}')
             return SetParametersResult(successful=False, reason=reason)
@@ -282,15 +333,70 @@ class HystNode(Node):
 
     # ---------------------------------------------------------- diagnostics
     def publish_diagnostics(self, level: int, message: str,
-                            values: Mapping[str, Any] | None = None) -> None:
-        """Publish one DiagnosticStatus named ``hyst_id: <node name>``."""
+                            values: Mapping[str, Any] | None = None,
+                            extra: Sequence[DiagnosticStatus] = ()) -> None:
+        """Publish a DiagnosticStatus named ``hyst_id: <node name>`` (then ``extra``)."""
         if self._diag_pub is None:
             self._diag_pub = self.create_publisher(DiagnosticArray, DIAGNOSTICS_TOPIC,
                                                    DIAGNOSTICS_QOS)
-        self._diag_pub.publish(diagnostic_array(self, f'hyst_id: {self.get_name()}', level,
-                                                message, values))
+        arr = diagnostic_array(self, f'hyst_id: {self.get_name()}', level, message, values)
+        arr.status.extend(extra)
+        try_publish(self._diag_pub, arr)
 
 
 def _first_line(exc: BaseException) -> str:
     text = str(exc).strip().splitlines()
     return text[0] if text else type(exc).__name__
+
+
+class ParameterPusher:
+    """Send a parameter list to another node's ``set_parameters_atomically``.
+
+    :meth:`push` queues one request (replacing a pending one); :meth:`poll`,
+    called from a timer of ``node``, sends it once the service is up, or
+    drops it with a warning after ``timeout_s``. The answer is logged
+    (rejections with the target's reason); nothing ever blocks the executor.
+    """
+
+    def __init__(self, node: Node) -> None:
+        self.node = node
+        self._client = None
+        self._pending: tuple[str, list[Parameter], float] | None = None
+
+    def push(self, target_node: str, params: list[Parameter], timeout_s: float) -> None:
+        """Queue ``params`` for ``<target_node>/set_parameters_atomically``."""
+        name = target_node.rstrip('/') + '/set_parameters_atomically'
+        self._pending = (name, params, time.monotonic() + timeout_s)
+
+    def poll(self) -> None:
+        """Send the pending request if its service is ready (call from a timer)."""
+        if self._pending is None:
+            return
+        name, params, deadline = self._pending
+        if self._client is None or self._client.srv_name != name:
+            if self._client is not None:
+                self.node.destroy_client(self._client)
+            self._client = self.node.create_client(SetParametersAtomically, name)
+        if not self._client.service_is_ready():
+            if time.monotonic() > deadline:
+                self.node.get_logger().warning(
+                    f'{name} not available: parameters not pushed (they are on the latched '
+                    'topic and in the params file)')
+                self._pending = None
+            return
+        self._pending = None
+        future = self._client.call_async(SetParametersAtomically.Request(
+            parameters=[p.to_parameter_msg() for p in params]))
+        future.add_done_callback(lambda f, n=name: self._done(f, n))
+
+    def _done(self, future: Any, name: str) -> None:
+        log = self.node.get_logger()
+        try:
+            result = future.result().result
+        except Exception as exc:  # noqa: BLE001 - a failed call is logged, not raised
+            log.warning(f'{name} failed: {exc}')
+            return
+        if result.successful:
+            log.info(f'pushed the parameters to {name}')
+        else:
+            log.warning(f'{name} rejected the parameters: {result.reason}')

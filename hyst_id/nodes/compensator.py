@@ -21,9 +21,18 @@ and the last good set stays in use. Unset parameters are ``.nan``; while no
 complete valid set exists the node passes the desired value through (within
 the command limits) and says so in its log and on ``/diagnostics``.
 
-Coupled parameters (``c_l < c_r``...) must change together: use
-``set_parameters_atomically`` (the identifier does), a params file, or the
-latched identified-parameters topic, which the node also follows.
+Coupled parameters must change together: use ``set_parameters_atomically``
+(the identifier does), a params file, or the latched identified-parameters
+topic, which the node also follows. Each accepted change that alters the
+output (model or command limits) starts a new *generation*: it applies
+between two samples, to every sample from the next one on, and the node
+publishes it (generation, first sample it applies to, the full set and
+limits, where it came from) on the latched ``~/active_set`` topic
+(std_msgs/String JSON), so which set produced which command can be checked.
+
+Commands are published reliable keep-all (:data:`hyst_id.nodes.COMMAND_QOS`):
+a command the middleware refuses (a subscriber stalled for seconds) is
+counted and reported on ``/diagnostics`` (ERROR), never dropped silently.
 """
 
 from __future__ import annotations
@@ -38,6 +47,7 @@ from typing import Any
 import rclpy
 from rclpy.executors import ExternalShutdownException
 from rclpy.parameter import Parameter
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from std_msgs.msg import Float64, String
 
 from hyst_id.compensate import CommandLimits, Compensator as CoreCompensator, InverseModel
@@ -45,12 +55,16 @@ from hyst_id.errors import HystIdError, InvalidParametersError
 from hyst_id.io.params_file import COMPENSATOR_NAMES
 from hyst_id.io.recording import CHANNELS
 from hyst_id.nodes import (COMMAND_QOS, DESIRED_TOPIC, HystNode, IDENTIFIED_PARAMS_TOPIC, init_ros,
-                           LATCHED_QOS, Param, topic_params)
+                           LATCHED_QOS, Param, topic_params, try_publish)
 
-__all__ = ['Compensator', 'PARAMS', 'main']
+__all__ = ['ACTIVE_SET_QOS', 'Compensator', 'PARAMS', 'main']
 
 _NAN = math.nan
 _MODEL_KEYS = set(COMPENSATOR_NAMES) | {'output_sign'}
+_LIMIT_KEYS = {'min_command', 'max_command', 'max_rate_per_s'}
+#: ``~/active_set``: every generation, late joiners get the last 100.
+ACTIVE_SET_QOS = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE,
+                            durability=DurabilityPolicy.TRANSIENT_LOCAL)
 _DESCRIPTIONS = {
     'm_l': 'hysteresis left-line slope', 'm_r': 'hysteresis right-line slope',
     'm_t': 'hysteresis top-line slope', 'm_b': 'hysteresis bottom-line slope',
@@ -115,9 +129,13 @@ class Compensator(HystNode):
         self._comp = CoreCompensator(model, _limits(values), v0=values['initial_command'])
         self._source = 'params' if model is not None else ''
         self._n = 0
+        self._not_sent = 0
+        self._generation = 0
         self._step_ns: deque[int] = deque(maxlen=2000)
         self._cmd_pub = self.create_publisher(Float64, self.p('topics.command_topic'),
                                               COMMAND_QOS)
+        self._set_pub = self.create_publisher(String, '~/active_set', ACTIVE_SET_QOS)
+        self._publish_active_set('parameters at start')
         self.create_subscription(Float64, self.p('topics.desired_topic'), self._on_desired,
                                  COMMAND_QOS)
         self.create_subscription(String, self.p('topics.identified_params_topic'),
@@ -161,30 +179,48 @@ class Compensator(HystNode):
     def apply_params(self, values: dict[str, Any], changed: set[str]) -> None:
         if not hasattr(self, '_comp'):
             return
-        if changed & {'min_command', 'max_command', 'max_rate_per_s'}:
+        before = (self._comp.model, self._comp.limits)
+        if changed & _LIMIT_KEYS:
             self._comp.limits = _limits(values)
         if 'diagnostics_period_s' in changed:
             self._diag_timer.cancel()
             self.destroy_timer(self._diag_timer)
             self._diag_timer = self.create_timer(values['diagnostics_period_s'],
                                                  self._publish_status)
+        source = self._source_hint or 'set_parameters'
+        self._source_hint = ''
         if changed & _MODEL_KEYS:
             kind, model, unset = _model_state(values)
-            if model is not None and model == self._comp.model:
-                self._source_hint = ''
-                return
-            self._comp.set_model(model)
-            if model is not None:
-                self._source = self._source_hint or 'set_parameters'
-                self.get_logger().info(f'applied parameter set from {self._source}: '
-                                       f'{self._describe(values)}')
-            elif kind == 'none':
-                self._source = ''
-                self.get_logger().warning('parameter set cleared: passing the desired value '
-                                          'through unchanged')
-            else:
-                self.get_logger().info(f'parameter set incomplete (unset: {", ".join(unset)})')
-        self._source_hint = ''
+            if model is None or model != self._comp.model:
+                self._comp.set_model(model)
+                if model is not None:
+                    self._source = source
+                    self.get_logger().info(f'applied parameter set from {source}: '
+                                           f'{self._describe(values)}')
+                elif kind == 'none':
+                    self._source = ''
+                    self.get_logger().warning('parameter set cleared: passing the desired '
+                                              'value through unchanged')
+                else:
+                    self.get_logger().info(f'parameter set incomplete (unset: '
+                                           f'{", ".join(unset)})')
+        if (self._comp.model, self._comp.limits) != before:
+            self._generation += 1
+            self._publish_active_set(source, values)
+
+    def _publish_active_set(self, source: str, values: dict[str, Any] | None = None) -> None:
+        """Publish the set in use from the next sample on (``~/active_set``)."""
+        values = values or self.param_values()
+        model = self._comp.model
+        lim = self._comp.limits
+        doc = {'generation': self._generation, 'first_sample': self._n, 'source': source,
+               'channel': values['channel'],
+               'model': None if model is None else {
+                   n: values[n] for n in COMPENSATOR_NAMES + ('output_sign',)},
+               'min_command': lim.min_command, 'max_command': lim.max_command,
+               'max_rate_per_s': None if math.isinf(lim.max_rate_per_s)
+               else lim.max_rate_per_s}
+        try_publish(self._set_pub, String(data=json.dumps(doc)))
 
     _source_hint = ''
 
@@ -202,8 +238,11 @@ class Compensator(HystNode):
         t0 = time.perf_counter_ns()
         v = self._comp.step(float(msg.data), t_s)
         self._step_ns.append(time.perf_counter_ns() - t0)
-        self._cmd_pub.publish(Float64(data=v))
         self._n += 1
+        if not try_publish(self._cmd_pub, Float64(data=v)):
+            self._not_sent += 1
+            self.get_logger().error(f'{self._not_sent} command(s) refused by the middleware '
+                                    '(a subscriber stalled?)', throttle_duration_sec=1.0)
         if not math.isfinite(msg.data):
             self.get_logger().warning('non-finite desired value: holding the last command',
                                       throttle_duration_sec=5.0)
@@ -243,8 +282,13 @@ class Compensator(HystNode):
         median_us = statistics.median(steps) / 1e3 if steps else _NAN
         values = {'channel': self.p('channel'), 'samples': self._n,
                   'compute_median_us': median_us, 'source': self._source or 'none',
-                  'er_percent': self.p('er_percent'), 'command': self._comp.state[0]}
-        if model is None:
+                  'er_percent': self.p('er_percent'), 'command': self._comp.state[0],
+                  'generation': self._generation, 'rejected_updates': self.rejected_updates,
+                  'commands_not_sent': self._not_sent}
+        if self._not_sent:
+            self.publish_diagnostics(2, f'{self._not_sent} command(s) could not be sent (a '
+                                     'subscriber stalled?)', values)
+        elif model is None:
             self.publish_diagnostics(1, 'no valid parameter set: passing the desired value '
                                      'through unchanged', values)
         else:

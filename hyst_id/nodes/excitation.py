@@ -40,7 +40,7 @@ from std_msgs.msg import Float64
 from hyst_id.errors import ConfigError, HystIdError
 from hyst_id.excitation import (DEFAULT_MULTISINE_HZ, DEFAULT_STEP_LEVELS_MA, EXCITATIONS,
                                 make_excitation)
-from hyst_id.nodes import (COMMAND_QOS, HystNode, init_ros, Param, topic_params)
+from hyst_id.nodes import COMMAND_QOS, HystNode, init_ros, Param, topic_params, try_publish
 
 __all__ = ['Excitation', 'PARAMS', 'main', 'profile_kwargs']
 
@@ -213,7 +213,11 @@ class Excitation(HystNode):
             self._finish()
             return
         t_s = self._k * self.p('sample_period_s')
-        self._pub.publish(Float64(data=self._profile(t_s)))
+        if not try_publish(self._pub, Float64(data=self._profile(t_s))):
+            self.get_logger().warning(f'sample {self._k} refused by the middleware (a '
+                                      'subscriber stalled?): retrying it on the next tick',
+                                      throttle_duration_sec=1.0)
+            return
         self._k += 1
 
     def _finish(self) -> None:

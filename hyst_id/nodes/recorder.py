@@ -25,6 +25,14 @@ stamped right after the command that caused it is never logged before that
 command, however late delivery was, and readers pairing streams by stamp
 (``hyst_id.io.readers``) pair them as they happened. The bag is finalised
 on Ctrl-C / SIGTERM (the summary and ``metadata.yaml`` are written).
+
+Crash safety: messages go into MCAP chunks that are written (and flushed to
+the OS) once they hold ``chunk_size`` bytes or span ``chunk_span_s`` of log
+time, and at least every ``flush_period_s``. A recorder killed outright
+(SIGKILL, power cut with ``fsync``) leaves a file whose complete chunks
+``recover_truncated=True`` reads: it loses only the pending chunk, i.e. at
+most the last ``chunk_span_s`` (1 s by default) of messages before the kill,
+plus any messages still in transit to it.
 """
 
 from __future__ import annotations
@@ -41,7 +49,7 @@ from rclpy.qos import (DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityP
 from hyst_id.errors import ConfigError, HystIdError
 from hyst_id.io.bag import BagWriter
 from hyst_id.nodes import (DESIRED_TOPIC, HystNode, IDENTIFIED_PARAMS_TOPIC, init_ros,
-                           message_class, Param, topic_params)
+                           message_class, Param, source_time_ns, topic_params)
 
 __all__ = ['PARAMS', 'Recorder', 'default_bag_name', 'main']
 
@@ -58,6 +66,8 @@ PARAMS = [
           high=3600.0, unit='s', read_only=True),
     Param('chunk_size', 65536, 'largest MCAP chunk before it is written', low=1024,
           high=1048576, unit='bytes', read_only=True),
+    Param('chunk_span_s', 1.0, 'longest log-time span of an MCAP chunk before it is written '
+          '(0 = no limit)', low=0.0, high=3600.0, unit='s', read_only=True),
 ]
 
 
@@ -67,11 +77,13 @@ def default_bag_name() -> str:
 
 
 def _qos_for(infos: list) -> QoSProfile:
+    """Best effort (deep queue) if any publisher is, else reliable keep-all (nothing lost)."""
     best_effort = any(i.qos_profile.reliability == ReliabilityPolicy.BEST_EFFORT
                       for i in infos)
     latched = bool(infos) and all(
         i.qos_profile.durability == DurabilityPolicy.TRANSIENT_LOCAL for i in infos)
-    return QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1000,
+    history = HistoryPolicy.KEEP_LAST if best_effort else HistoryPolicy.KEEP_ALL
+    return QoSProfile(history=history, depth=1000,
                       reliability=(ReliabilityPolicy.BEST_EFFORT if best_effort
                                    else ReliabilityPolicy.RELIABLE),
                       durability=(DurabilityPolicy.TRANSIENT_LOCAL if latched
@@ -89,7 +101,8 @@ class Recorder(HystNode):
         self._wanted = list(dict.fromkeys(topics))
         self.path = Path(self.p('output') or default_bag_name()).expanduser()
         self._lock = threading.Lock()
-        self._writer = BagWriter(self.path, chunk_size=self.p('chunk_size')).open()
+        self._writer = BagWriter(self.path, chunk_size=self.p('chunk_size'),
+                                 chunk_span_s=self.p('chunk_span_s')).open()
         self._subs: dict[str, Any] = {}
         self.counts: dict[str, int] = {}
         self.create_timer(self.p('discovery_period_s'), self._discover)
@@ -137,8 +150,7 @@ class Recorder(HystNode):
                                    f'{qos.reliability.name.lower()})')
 
     def _on_message(self, topic: str, data: bytes, info: dict) -> None:
-        t_ns = int(info.get('source_timestamp') or 0) or int(
-            info.get('received_timestamp') or 0) or self.get_clock().now().nanoseconds
+        t_ns = source_time_ns(self, info)
         with self._lock:
             if self._writer is None:
                 return
