@@ -17,10 +17,14 @@
 The noise standard deviation is estimated from the data itself, without a
 model: for difference orders ``d = 1, 2, 3`` the d-th differences of white
 noise have variance ``C(2d, d) sigma^2``; a smooth signal adds little to
-them, hysteresis kinks add a few outliers. A robust scale (MAD) of each
-order gives an estimate that can only be inflated by the signal, so the
-smallest of the three is taken. Quantised sensors (many repeated values)
-get at least the quantisation noise ``q / sqrt(12)``.
+them, hysteresis kinks and backlash jumps add a few outliers. Each order's
+scale is a *trimmed* root mean square (the largest 5 % of deviations from
+the median dropped, corrected for the trimming of a Gaussian), which
+ignores the outliers but, unlike a median of absolute deviations, is not
+fooled by A/D quantisation (differences of quantised noise take only a few
+discrete values). The signal can only inflate each order's estimate, so the
+smallest of the three is taken. Heavily quantised sensors (many repeated
+values) get at least the quantisation noise ``q / sqrt(12)``.
 
 The noise floor is the %e_r (Eq. 7) a perfect model would score:
 ``sqrt(n sigma^2 / sum(y^2)) * 100``.
@@ -33,6 +37,12 @@ from math import comb
 import numpy as np
 
 __all__ = ['estimate_noise_std', 'noise_floor_percent']
+
+#: Share of the differences kept by the trimmed RMS.
+_KEEP = 0.95
+#: E[x^2 ; |x| < z] / (P(|x| < z) sigma^2) for a Gaussian trimmed to _KEEP
+#: (z = 1.95996): the trimmed RMS underestimates sigma by its square root.
+_TRIM_FACTOR = (0.95 - 2.0 * 1.959964 * 0.0584409) / 0.95
 
 
 def estimate_noise_std(measurement: np.ndarray) -> float:
@@ -54,8 +64,10 @@ def estimate_noise_std(measurement: np.ndarray) -> float:
         d = np.diff(y, n=order)
         if d.size < 8:
             continue
-        mad = np.median(np.abs(d - np.median(d)))
-        estimates.append(1.4826 * mad / np.sqrt(comb(2 * order, order)))
+        dev = np.abs(d - np.median(d))
+        kept = dev[dev <= np.quantile(dev, _KEEP)]
+        rms = np.sqrt(np.mean(kept ** 2) / _TRIM_FACTOR)
+        estimates.append(rms / np.sqrt(comb(2 * order, order)))
     sigma = min(estimates) if estimates else 0.0
     steps = np.abs(np.diff(y))
     steps = steps[steps > 0]
