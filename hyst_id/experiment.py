@@ -49,6 +49,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from hyst_id.compensate import CommandLimits, Compensator, InverseModel
+from hyst_id.domains import preset_spec
 from hyst_id.errors import ConfigError, InvalidParametersError
 from hyst_id.excitation import eq24, eq25
 from hyst_id.gauge import affine_map_output
@@ -459,7 +460,8 @@ def run_experiment(params_path=None, *, settings: IdentifySettings | None = None
                 digest = (mode, ch, rec.t_s.tobytes(), rec.command.tobytes(),
                           rec.measurement.tobytes())
                 if digest not in cache:
-                    cache[digest] = identify(rec, settings=_settings_for(settings, mode),
+                    cache[digest] = identify(rec, spec=preset_spec('paper', ch),
+                                             settings=_settings_for(settings, mode),
                                              progress=report)
                 elif progress:
                     progress(len(settings.seeds), total, f'{label}: same recording, reused')

@@ -36,6 +36,8 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from hyst_id.chains import chain_spec, ChainSpec, er_percent
+from hyst_id.diagnostics_checks import identification_warnings
+from hyst_id.domains import domains_from_data
 from hyst_id.errors import IdentificationError, InvalidParametersError
 from hyst_id.gaass import GaassSolver
 from hyst_id.gauge import canonical_gauge, output_sign
@@ -290,7 +292,9 @@ def identify(recording: Recording, *, spec: ChainSpec | None = None,
     recording : Recording
         The run to identify from (validated here).
     spec : ChainSpec, optional
-        Chain spec with search domains; default the paper's domains.
+        Chain spec with search domains; default derived from the recording
+        (:func:`hyst_id.domains.domains_from_data`). The paper's domains are
+        ``hyst_id.domains.preset_spec('paper', channel)``.
     settings : IdentifySettings, optional
         GAASS and refinement settings; default the paper's.
     progress : callable, optional
@@ -302,7 +306,7 @@ def identify(recording: Recording, *, spec: ChainSpec | None = None,
     """
     rec = validate_recording(recording)
     settings = settings or IdentifySettings()
-    spec = spec or chain_spec(rec.channel)
+    spec = spec or domains_from_data(rec)
     if spec.channel != rec.channel:
         raise IdentificationError(
             f'chain is for {spec.channel!r} but the recording is {rec.channel!r}')
@@ -329,7 +333,9 @@ def identify(recording: Recording, *, spec: ChainSpec | None = None,
                         progress(len(runs), len(settings.seeds), runs[-1])
             except BrokenProcessPool as exc:
                 raise IdentificationError(f'a worker process died: {exc}') from None
-    return summarise(rec, spec, settings, runs)
+    ident = summarise(rec, spec, settings, runs)
+    ident.warnings += identification_warnings(ident, rec, spec)
+    return ident
 
 
 def summarise(rec: Recording, spec: ChainSpec, settings: IdentifySettings,

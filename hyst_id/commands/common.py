@@ -20,7 +20,8 @@ import argparse
 
 import yaml
 
-from hyst_id.chains import CHAIN_NAMES, chain_spec, ChainSpec
+from hyst_id.chains import CHAIN_NAMES, ChainSpec
+from hyst_id.domains import domains_from_data, preset_spec, PRESETS
 from hyst_id.errors import ConfigError
 from hyst_id.identify import IdentifySettings
 from hyst_id.io.recording import Recording
@@ -63,7 +64,8 @@ def add_settings_arguments(parser: argparse.ArgumentParser) -> None:
                    'noise floor (default 4; 0 = one run per seed)')
     g.add_argument('--domains', default='auto', metavar='auto|paper|YAML',
                    help="search domains: derived from the data (auto), the paper's "
-                   'preset, or a YAML mapping name: [low, high]')
+                   'preset (paper), or a YAML mapping name: [low, high] that overrides '
+                   'the derived ones')
 
 
 def load_recording(args: argparse.Namespace) -> Recording:
@@ -96,14 +98,10 @@ def make_settings(args: argparse.Namespace) -> IdentifySettings:
 def make_spec(args: argparse.Namespace, rec: Recording) -> ChainSpec:
     """Chain spec with the search domains asked for."""
     choice = args.domains
-    if choice == 'paper':
-        return chain_spec(rec.channel)
     if choice == 'auto':
-        try:
-            from hyst_id.domains import domains_from_data
-        except ModuleNotFoundError:
-            return chain_spec(rec.channel)
         return domains_from_data(rec)
+    if choice in PRESETS:
+        return preset_spec(choice, rec.channel)
     try:
         with open(choice) as f:
             data = yaml.safe_load(f) or {}
@@ -119,4 +117,4 @@ def make_spec(args: argparse.Namespace, rec: Recording) -> ChainSpec:
         domains = {str(k): (float(v[0]), float(v[1])) for k, v in data.items()}
     except (TypeError, ValueError, IndexError):
         raise ConfigError(f'domains file {choice}: each entry must be [low, high]') from None
-    return chain_spec(rec.channel, domains=domains)
+    return domains_from_data(rec, overrides=domains)
