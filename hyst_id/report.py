@@ -95,15 +95,15 @@ def plot_identification(ident: Identification, rec: Recording, out_dir: str | Pa
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     y_fit = ident.spec().simulate(ident.x, rec.t_s, rec.command)
-    unit_c = rec.command_unit or 'command'
-    unit_y = rec.measurement_unit or rec.channel
+    unit_c = f' [{rec.command_unit}]' if rec.command_unit else ''
+    unit_y = f' [{rec.measurement_unit}]' if rec.measurement_unit else ''
     paths = []
 
     fig, ax = plt.subplots(figsize=(6, 5))
     ax.plot(rec.command, rec.measurement, '.', ms=2, alpha=0.5, label='measured')
     ax.plot(rec.command, y_fit, '-', lw=1, label='identified chain')
-    ax.set_xlabel(f'command [{unit_c}]')
-    ax.set_ylabel(f'{rec.channel} [{unit_y}]')
+    ax.set_xlabel(f'command{unit_c}')
+    ax.set_ylabel(f'{rec.channel}{unit_y}')
     ax.set_title(f'Hysteresis loop, {rec.channel}: %e_r {ident.er_percent:.2f}')
     ax.legend()
     paths.append(_save(fig, out / f'{stem}_loop.png'))
@@ -111,7 +111,7 @@ def plot_identification(ident: Identification, rec: Recording, out_dir: str | Pa
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
     a1.plot(rec.t_s, rec.measurement, lw=0.8, label='measured')
     a1.plot(rec.t_s, y_fit, lw=0.8, label='identified')
-    a1.set_ylabel(unit_y)
+    a1.set_ylabel(f'{rec.channel}{unit_y}')
     a1.legend()
     a2.plot(rec.t_s, rec.measurement - y_fit, lw=0.6, color='C3')
     a2.set_ylabel('residual')
