@@ -71,6 +71,7 @@ from rosbags.typesys import (
 )
 
 from hyst_id.errors import ConfigError, MissingTopicError, RecordingError
+from hyst_id.io.mcap_recover import lacks_footer, scan_records
 
 if TYPE_CHECKING:
     from rosbags.typesys.store import Typestore
@@ -98,7 +99,6 @@ DEFAULT_CHUNK_SPAN_S = 1.0
 #: Stamp of ``t_s = 0`` in bags made from a recording: 2026-01-01T00:00:00Z.
 DEFAULT_START_NS = 1_767_225_600 * 10**9
 
-_MAGIC = b'\x89MCAP0\r\n'
 _READ_ERRORS = (AnyReaderError, ReaderError, SerdeError, TypesysError, OSError, ValueError,
                 TypeError, KeyError, IndexError, EOFError, AssertionError, zlib.error)
 _PRIMITIVE_DTYPES = {
@@ -386,7 +386,7 @@ def open_bag(path: str | Path, *, recover_truncated: bool = False) -> Iterator[B
         failure = _one_line(exc)
     if failure is not None:
         mcaps = sorted(target.glob('*.mcap')) if target.is_dir() else [target]
-        if len(mcaps) == 1 and mcaps[0].suffix == '.mcap' and _lacks_footer(mcaps[0]):
+        if len(mcaps) == 1 and mcaps[0].suffix == '.mcap' and lacks_footer(mcaps[0]):
             if recover_truncated:
                 yield _recover(mcaps[0], path, notes)
                 return
@@ -413,89 +413,11 @@ def open_bag(path: str | Path, *, recover_truncated: bool = False) -> Iterator[B
         reader.close()
 
 
-def _lacks_footer(path: Path) -> bool:
-    try:
-        with path.open('rb') as fh:
-            head = fh.read(8)
-            fh.seek(0, os.SEEK_END)
-            if fh.tell() < 16:
-                return head == _MAGIC[:len(head)]
-            fh.seek(-8, os.SEEK_END)
-            return head == _MAGIC and fh.read(8) != _MAGIC
-    except OSError:
-        return False
-
-
-def _records(buf: bytes, start: int) -> Iterator[tuple[int, memoryview]]:
-    """Yield ``(opcode, body)`` of the complete MCAP records in ``buf[start:]``."""
-    view = memoryview(buf)
-    pos = start
-    while pos + 9 <= len(buf):
-        length = int.from_bytes(view[pos + 1:pos + 9], 'little')
-        if pos + 9 + length > len(buf):
-            return
-        yield buf[pos], view[pos + 9:pos + 9 + length]
-        pos += 9 + length
-
-
-def _string(body: memoryview, pos: int) -> tuple[str, int]:
-    n = int.from_bytes(body[pos:pos + 4], 'little')
-    return bytes(body[pos + 4:pos + 4 + n]).decode(), pos + 4 + n
-
-
-def _decompress(data: bytes, compression: str) -> bytes:
-    if compression == '':
-        return data
-    if compression == 'zstd':
-        try:
-            from compression import zstd
-        except ImportError:
-            from backports import zstd
-        return zstd.decompress(data)
-    if compression == 'lz4':
-        from lz4.frame import decompress
-        return decompress(data)
-    raise ValueError(f'unsupported chunk compression {compression!r}')
-
-
 def _recover(target: Path, path: Path, notes: list[str]) -> BagContents:
     """Read the complete records of a footer-less MCAP file (schemas, channels, messages)."""
     raw = target.read_bytes()
-    schemas: dict[int, tuple[str, str, str]] = {}
-    channels: dict[int, tuple[str, int, str]] = {}
-    messages: list[tuple[int, int, bytes]] = []
-
-    def scan(buf: bytes, start: int, top: bool) -> None:
-        for op, body in _records(buf, start):
-            if op == 0x03:
-                sid = int.from_bytes(body[:2], 'little')
-                name, pos = _string(body, 2)
-                enc, pos = _string(body, pos)
-                n = int.from_bytes(body[pos:pos + 4], 'little')
-                schemas[sid] = (name, enc, bytes(body[pos + 4:pos + 4 + n]).decode())
-            elif op == 0x04:
-                cid = int.from_bytes(body[:2], 'little')
-                sid = int.from_bytes(body[2:4], 'little')
-                topic, pos = _string(body, 4)
-                enc, _ = _string(body, pos)
-                channels[cid] = (topic, sid, enc)
-            elif op == 0x05:
-                cid = int.from_bytes(body[:2], 'little')
-                messages.append((int.from_bytes(body[6:14], 'little'), cid, bytes(body[22:])))
-            elif op == 0x06 and top:
-                size = int.from_bytes(body[16:24], 'little')
-                crc = int.from_bytes(body[24:28], 'little')
-                comp, pos = _string(body, 28)
-                n = int.from_bytes(body[pos:pos + 8], 'little')
-                data = _decompress(bytes(body[pos + 8:pos + 8 + n]), comp)
-                if len(data) != size or (crc and zlib.crc32(data) != crc):
-                    raise ValueError('chunk checksum or size mismatch: the file is corrupt')
-                scan(data, 0, False)
-            elif op == 0x02:
-                return
-
     try:
-        scan(raw, 8, True)
+        schemas, channels, messages = scan_records(raw)
         store = get_typestore(Stores.EMPTY)
         for name, enc, text in schemas.values():
             store.register(get_types_from_idl(text) if enc == 'ros2idl'
