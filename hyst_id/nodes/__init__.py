@@ -51,17 +51,19 @@ from rcl_interfaces.srv import SetParametersAtomically
 import rclpy
 from rclpy.exceptions import (InvalidParameterTypeException, InvalidParameterValueException,
                               ParameterException)
+from rclpy.executors import ExternalShutdownException
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import (DurabilityPolicy, HistoryPolicy, qos_profile_sensor_data, QoSProfile,
                        ReliabilityPolicy)
 
-from hyst_id.errors import ConfigError
+from hyst_id.errors import ConfigError, HystIdError
 from hyst_id.io.readers import TopicConfig
 from hyst_id.io.recording import CHANNELS
 
 __all__ = [
+    'spin_node',
     'COMMAND_QOS', 'DESIRED_TOPIC', 'DIAGNOSTICS_QOS', 'DIAGNOSTICS_TOPIC', 'HystNode',
     'IDENTIFIED_PARAMS_TOPIC', 'LATCHED_QOS', 'Param', 'ParameterPusher', 'SENSOR_QOS',
     'TOPIC_KEYS',
@@ -213,6 +215,32 @@ def source_time_ns(node: Node, info: Mapping[str, Any]) -> int:
     """A message's source timestamp (from the middleware), else its receive time, else now."""
     return int(info.get('source_timestamp') or 0) or int(
         info.get('received_timestamp') or 0) or node.get_clock().now().nanoseconds
+
+
+def spin_node(node_class: type, name: str, args: list[str] | None = None) -> int:
+    """Init, spin and shut down one node: the body of every node's ``main()``.
+
+    The demo_nodes_py pattern: Ctrl-C and an external shutdown (SIGTERM) end
+    the spin quietly; a :class:`~hyst_id.errors.HystIdError` raised while the
+    node is built (a bad params file) is logged in one line with exit code 2;
+    the node is always destroyed and the context shut down.
+    """
+    if not init_ros(args, name):
+        return 2
+    node = None
+    try:
+        node = node_class()
+        rclpy.spin(node)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    except HystIdError as exc:
+        rclpy.logging.get_logger(name).error(str(exc))
+        return 2
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+    return 0
 
 
 def stamp_ns(stamp: Any) -> int:

@@ -36,15 +36,13 @@ import math
 from typing import Any
 
 import numpy as np
-import rclpy
-from rclpy.executors import ExternalShutdownException
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64
 
-from hyst_id.errors import ConfigError, HystIdError, InvalidParametersError
+from hyst_id.errors import ConfigError, InvalidParametersError
 from hyst_id.models.backlash import backlash_step, check_backlash
 from hyst_id.models.hysteresis import check_hysteresis, hysteresis_step, initial_output
-from hyst_id.nodes import (COMMAND_QOS, HystNode, init_ros, Param, SENSOR_QOS, topic_params)
+from hyst_id.nodes import (COMMAND_QOS, HystNode, Param, SENSOR_QOS, spin_node, topic_params)
 
 __all__ = ['ActuatorDriver', 'ActuatorInterface', 'PAPER_BACKLASH', 'PAPER_HYSTERESIS',
            'PARAMS', 'SimulatedActuator', 'main']
@@ -199,22 +197,7 @@ class ActuatorDriver(HystNode):
 
 def main(args: list[str] | None = None) -> int:
     """Run the actuator driver until Ctrl-C / SIGTERM."""
-    if not init_ros(args, 'actuator_driver'):
-        return 2
-    node = None
-    try:
-        node = ActuatorDriver()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    except HystIdError as exc:
-        rclpy.logging.get_logger('actuator_driver').error(str(exc))
-        return 2
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
-    return 0
+    return spin_node(ActuatorDriver, 'actuator_driver', args)
 
 
 if __name__ == '__main__':

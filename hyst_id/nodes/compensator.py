@@ -44,18 +44,16 @@ import statistics
 import time
 from typing import Any
 
-import rclpy
-from rclpy.executors import ExternalShutdownException
 from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from std_msgs.msg import Float64, String
 
 from hyst_id.compensate import CommandLimits, Compensator as CoreCompensator, InverseModel
-from hyst_id.errors import HystIdError, InvalidParametersError
+from hyst_id.errors import InvalidParametersError
 from hyst_id.io.params_file import COMPENSATOR_NAMES
 from hyst_id.io.recording import CHANNELS
-from hyst_id.nodes import (COMMAND_QOS, DESIRED_TOPIC, HystNode, IDENTIFIED_PARAMS_TOPIC, init_ros,
-                           LATCHED_QOS, Param, topic_params, try_publish)
+from hyst_id.nodes import (COMMAND_QOS, DESIRED_TOPIC, HystNode, IDENTIFIED_PARAMS_TOPIC,
+                           LATCHED_QOS, Param, spin_node, topic_params, try_publish)
 
 __all__ = ['ACTIVE_SET_QOS', 'Compensator', 'PARAMS', 'main']
 
@@ -306,22 +304,7 @@ class Compensator(HystNode):
 
 def main(args: list[str] | None = None) -> int:
     """Run the compensator node until Ctrl-C / SIGTERM."""
-    if not init_ros(args, 'compensator'):
-        return 2
-    node = None
-    try:
-        node = Compensator()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    except HystIdError as exc:
-        rclpy.logging.get_logger('compensator').error(str(exc))
-        return 2
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
-    return 0
+    return spin_node(Compensator, 'compensator', args)
 
 
 if __name__ == '__main__':

@@ -33,14 +33,12 @@ import math
 from typing import Any, Callable
 
 import numpy as np
-import rclpy
-from rclpy.executors import ExternalShutdownException
 from std_msgs.msg import Float64
 
-from hyst_id.errors import ConfigError, HystIdError
+from hyst_id.errors import ConfigError
 from hyst_id.excitation import (DEFAULT_MULTISINE_HZ, DEFAULT_STEP_LEVELS_MA, EXCITATIONS,
                                 make_excitation)
-from hyst_id.nodes import COMMAND_QOS, HystNode, init_ros, Param, topic_params, try_publish
+from hyst_id.nodes import COMMAND_QOS, HystNode, Param, spin_node, topic_params, try_publish
 
 __all__ = ['Excitation', 'PARAMS', 'main', 'profile_kwargs']
 
@@ -236,22 +234,7 @@ class Excitation(HystNode):
 
 def main(args: list[str] | None = None) -> int:
     """Run the excitation node until the run ends (with shutdown_when_done) or Ctrl-C."""
-    if not init_ros(args, 'excitation'):
-        return 2
-    node = None
-    try:
-        node = Excitation()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    except HystIdError as exc:
-        rclpy.logging.get_logger('excitation').error(str(exc))
-        return 2
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
-    return 0
+    return spin_node(Excitation, 'excitation', args)
 
 
 if __name__ == '__main__':

@@ -40,8 +40,6 @@ import time
 from typing import Any, Callable
 
 from diagnostic_msgs.msg import DiagnosticStatus
-import rclpy
-from rclpy.executors import ExternalShutdownException
 from rclpy.parameter import Parameter
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 from std_msgs.msg import Float64, String
@@ -56,8 +54,8 @@ from hyst_id.io.recording import CHANNELS, Recording, validate_recording
 from hyst_id.live import (diagnosis_statuses, DiagnosisJob, IdentificationJob,
                           recovered_document, result_document, SampleBuffer, warm_up_kernels)
 from hyst_id.nodes import (COMMAND_QOS, diagnostic_array, field_params, HystNode,
-                           IDENTIFIED_PARAMS_TOPIC, init_ros, LATCHED_QOS, message_class, Param,
-                           ParameterPusher, source_time_ns, stamp_ns, topic_params)
+                           IDENTIFIED_PARAMS_TOPIC, LATCHED_QOS, message_class, Param,
+                           ParameterPusher, source_time_ns, spin_node, stamp_ns, topic_params)
 
 try:  # optional: std_srvs is not a dependency of the package
     from std_srvs.srv import Trigger
@@ -458,22 +456,7 @@ class Identifier(HystNode):
 
 def main(args: list[str] | None = None) -> int:
     """Run the identifier until Ctrl-C / SIGTERM."""
-    if not init_ros(args, 'identifier'):
-        return 2
-    node = None
-    try:
-        node = Identifier()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    except HystIdError as exc:
-        rclpy.logging.get_logger('identifier').error(str(exc))
-        return 2
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
-    return 0
+    return spin_node(Identifier, 'identifier', args)
 
 
 if __name__ == '__main__':

@@ -47,16 +47,14 @@ from typing import Any
 
 from builtin_interfaces.msg import Time
 import numpy as np
-import rclpy
-from rclpy.executors import ExternalShutdownException
 from sensor_msgs.msg import FluidPressure, JointState
 from std_msgs.msg import Float64
 
-from hyst_id.errors import ConfigError, HystIdError, InvalidParametersError
+from hyst_id.errors import ConfigError, InvalidParametersError
 from hyst_id.models.backlash import check_backlash
 from hyst_id.models.hysteresis import check_hysteresis
 from hyst_id.models.sensors import first_order_coefficient, second_order_coefficients
-from hyst_id.nodes import (COMMAND_QOS, HystNode, init_ros, Param, SENSOR_QOS, topic_params)
+from hyst_id.nodes import (COMMAND_QOS, HystNode, Param, SENSOR_QOS, spin_node, topic_params)
 from hyst_id.nodes.actuator_driver import PAPER_BACKLASH, PAPER_HYSTERESIS, SimulatedActuator
 
 __all__ = ['PARAMS', 'PipelineSim', 'PlantModel', 'PlantReading', 'RigPlant', 'SimplePlant',
@@ -275,22 +273,7 @@ class PipelineSim(HystNode):
 
 def main(args: list[str] | None = None) -> int:
     """Run the pipeline simulator until Ctrl-C / SIGTERM."""
-    if not init_ros(args, 'pipeline_sim'):
-        return 2
-    node = None
-    try:
-        node = PipelineSim()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    except HystIdError as exc:
-        rclpy.logging.get_logger('pipeline_sim').error(str(exc))
-        return 2
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
-    return 0
+    return spin_node(PipelineSim, 'pipeline_sim', args)
 
 
 if __name__ == '__main__':

@@ -43,13 +43,12 @@ import threading
 from typing import Any
 
 import rclpy
-from rclpy.executors import ExternalShutdownException
 from rclpy.qos import (DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy)
 
-from hyst_id.errors import ConfigError, HystIdError
+from hyst_id.errors import ConfigError
 from hyst_id.io.bag import BagWriter
-from hyst_id.nodes import (DESIRED_TOPIC, HystNode, IDENTIFIED_PARAMS_TOPIC, init_ros,
-                           message_class, Param, source_time_ns, topic_params)
+from hyst_id.nodes import (DESIRED_TOPIC, HystNode, IDENTIFIED_PARAMS_TOPIC, message_class,
+                           Param, source_time_ns, spin_node, topic_params)
 
 __all__ = ['PARAMS', 'Recorder', 'default_bag_name', 'main']
 
@@ -196,22 +195,7 @@ class Recorder(HystNode):
 
 def main(args: list[str] | None = None) -> int:
     """Record until Ctrl-C / SIGTERM, then finalise the bag."""
-    if not init_ros(args, 'recorder'):
-        return 2
-    node = None
-    try:
-        node = Recorder()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    except HystIdError as exc:
-        rclpy.logging.get_logger('recorder').error(str(exc))
-        return 2
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
-    return 0
+    return spin_node(Recorder, 'recorder', args)
 
 
 if __name__ == '__main__':
