@@ -59,7 +59,7 @@ DEFAULT_COLUMNS = ('t', 'command', 'measurement')
 #: Per channel: topic, message type, field path, unit.
 _COMMAND_DEFAULTS = ('/hyst_id/command', 'std_msgs/msg/Float64', 'data', 'mA')
 _CHANNEL_DEFAULTS = {
-    'position': ('/hyst_id/position', 'sensor_msgs/msg/JointState', 'position[0]', 'rad'),
+    'position': ('/hyst_id/position', 'sensor_msgs/msg/JointState', 'position[0]', ''),
     'pressure': ('/hyst_id/pressure', 'sensor_msgs/msg/FluidPressure', 'fluid_pressure', 'Pa'),
     'flow': ('/hyst_id/flow', 'std_msgs/msg/Float64', 'data', 'g/s'),
 }
