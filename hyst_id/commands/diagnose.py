@@ -1,0 +1,126 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""``hyst-id diagnose RECORDING``: where the record departs from the model, and which physics.
+
+Without ``--sim`` the paper's chain of the channel is fitted on the first
+part of the record (``--train-fraction``, default 0.7) and the library of
+mechanisms is tested against the held-out rest (:mod:`hyst_id.diagnose`).
+With ``--sim PARAMS.yaml`` the rig simulator is driven by the recording's
+command instead, its found effects are switched on and the updated
+parameters written (``--sim-out``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+import sys
+
+from hyst_id.commands.common import (
+    add_recording_arguments,
+    add_settings_arguments,
+    load_recording,
+    make_spec,
+)
+from hyst_id.errors import ConfigError
+
+__all__ = ['add_arguments', 'run']
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Register the arguments of ``diagnose``."""
+    add_recording_arguments(parser)
+    add_settings_arguments(parser)
+    parser.set_defaults(seeds=2, generations=200)
+    g = parser.add_argument_group('diagnosis')
+    g.add_argument('--train-fraction', type=float, default=0.7,
+                   help='share of the duration used for fitting; the rest is held out')
+    g.add_argument('--mechanisms', default=None, metavar='ID,ID',
+                   help='mechanisms to test (default: all of them)')
+    g.add_argument('--max-mechanisms', type=int, default=2,
+                   help='most mechanisms added one after the other (default 2)')
+    g.add_argument('--json', metavar='FILE', help='write the diagnosis as JSON')
+    g.add_argument('--plot', metavar='FILE.png|DIR', help='write the figure')
+    g.add_argument('--sim', metavar='PARAMS.yaml',
+                   help='compare the rig simulator with these parameters against the '
+                   'recording (no baseline fit)')
+    g.add_argument('--sim-out', metavar='FILE.yaml',
+                   help='updated simulator parameters (default: <params>_diagnosed.yaml in '
+                   'the current directory)')
+
+
+def _settings(args: argparse.Namespace):
+    from hyst_id.diagnose import DiagnoseSettings
+    from hyst_id.diagnose.mechanisms import get_mechanisms
+
+    if args.seeds < 1 or args.pop_size < 2 or args.generations < 1:
+        raise ConfigError('need --seeds >= 1, --pop-size >= 2 and --generations >= 1')
+    if args.max_mechanisms < 1:
+        raise ConfigError('--max-mechanisms must be at least 1')
+    mechs = None
+    if args.mechanisms:
+        mechs = tuple(m.strip() for m in args.mechanisms.split(',') if m.strip())
+        get_mechanisms(mechs)
+    return DiagnoseSettings(
+        train_fraction=args.train_fraction,
+        seeds=tuple(range(args.seed_offset, args.seed_offset + args.seeds)),
+        generations=args.generations, pop_size=args.pop_size, workers=args.workers,
+        mechanisms=mechs, max_mechanisms=args.max_mechanisms)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Diagnose and print the report."""
+    from hyst_id.diagnose import diagnose
+    from hyst_id.diagnose.report import plot_diagnosis
+
+    settings = _settings(args)
+    if not 0.0 < args.train_fraction < 1.0:
+        raise ConfigError(f'--train-fraction must be in (0, 1), got {args.train_fraction}')
+    rec = load_recording(args)
+    say = None if args.quiet else (lambda msg: print(f'[diagnose] {msg}', file=sys.stderr))
+    print(f'{rec.source}: {rec.n_samples} samples over {rec.duration_s:.1f} s, channel '
+          f'{rec.channel}', file=sys.stderr)
+    updated = None
+    if args.sim:
+        from hyst_id.diagnose.sim_compare import diagnose_sim
+        from hyst_id.rig import load_rig_params
+        base = load_rig_params(args.sim)
+        diag, updated = diagnose_sim(rec, base, settings=settings, progress=say)
+    else:
+        spec = None if args.domains == 'auto' else make_spec(args, rec)
+        diag = diagnose(rec, spec=spec, settings=settings, progress=say)
+    print(diag.report())
+    if updated is not None:
+        from hyst_id.rig import save_rig_params
+        out = Path(args.sim_out) if args.sim_out else Path(
+            f'{Path(args.sim).stem}_diagnosed.yaml')
+        save_rig_params(updated, out)
+        diag.extra['simulator_params_out'] = str(out)
+        print(f'wrote {out} (simulator with the found effects switched on)', file=sys.stderr)
+    if args.json:
+        try:
+            Path(args.json).write_text(json.dumps(diag.to_dict(), indent=2) + '\n',
+                                       encoding='utf-8')
+        except OSError as exc:
+            raise ConfigError(f'cannot write {args.json}: {exc.strerror}') from None
+        print(f'wrote {args.json}', file=sys.stderr)
+    if args.plot:
+        try:
+            path = plot_diagnosis(diag, args.plot)
+        except OSError as exc:
+            raise ConfigError(f'cannot write the figure {args.plot}: {exc.strerror}') from None
+        print(f'wrote {path}', file=sys.stderr)
+    return 0

@@ -1,0 +1,224 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""The interface every mechanism of the library implements.
+
+A mechanism is a parametric block inserted at its physical place in the
+chain ``v -> [command] -> H -> B -> [position] -> [sensed quantity] ->
+sensor -> [sensor] -> calibration -> [output] -> y``. It has
+
+* *searched* parameters ``theta`` (nonlinear, fitted by a grid of starts and
+  bounded least squares together with the chain's parameters), declared by
+  :attr:`Mechanism.names` with bounds from :meth:`Mechanism.bounds`;
+* optionally *linear* parameters, which join the affine calibration and
+  are profiled out in closed form (:attr:`Mechanism.n_linear`);
+* one hook per stage it acts in (the others are the identity);
+* words: what it is physically, how to read its fitted values, which
+  located evidence speaks for it.
+
+Position-stage quantities (bands, stops, curvature) are expressed as
+fractions of the travel that the *training* part of the record covers, so
+they do not depend on the chain's gauge (the arbitrary scale and offset of
+the signal between H and the calibration).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Sequence
+
+import numpy as np
+
+__all__ = ['STAGES', 'Context', 'Mechanism', 'Quantity', 'clip_theta']
+
+#: Stages in signal order.
+STAGES = ('command', 'actuator', 'position', 'quantity', 'sensor', 'output')
+
+
+@dataclass(frozen=True)
+class Quantity:
+    """A reported value with its unit and a short meaning."""
+
+    value: float
+    unit: str
+    meaning: str = ''
+
+    def to_dict(self) -> dict:
+        """JSON-ready form."""
+        return {'value': float(self.value), 'unit': self.unit, 'meaning': self.meaning}
+
+
+@dataclass
+class Context:
+    """What mechanisms need to know about the recording and the fit.
+
+    Attributes
+    ----------
+    channel : str
+        Measured channel.
+    t_s : numpy.ndarray
+        Sample times of the whole record, seconds.
+    n_train : int
+        Samples in the training part (the first ones).
+    command_scale : tuple of float
+        ``(a, b)`` with ``command_original = a * command_model + b``.
+    command_unit, measurement_unit : str
+        Units for the words.
+    extra : dict
+        Anything else (e.g. the baseline travel) a mechanism wants to keep.
+    """
+
+    channel: str
+    t_s: np.ndarray
+    n_train: int
+    command_scale: tuple[float, float] = (1.0, 0.0)
+    command_unit: str = ''
+    measurement_unit: str = ''
+    extra: dict = field(default_factory=dict)
+
+    @property
+    def dt_s(self) -> float:
+        """Median sample interval, seconds."""
+        return float(np.median(np.diff(self.t_s)))
+
+    @property
+    def train_duration_s(self) -> float:
+        """Duration of the training part, seconds."""
+        return float(self.t_s[self.n_train - 1] - self.t_s[0])
+
+    @property
+    def duration_s(self) -> float:
+        """Duration of the whole record, seconds."""
+        return float(self.t_s[-1] - self.t_s[0])
+
+    @property
+    def period_s(self) -> float:
+        """Typical time between command reversals times two (a loop period)."""
+        return float(self.extra.get('period_s', 10.0))
+
+    def cmd(self, value_model_units: float) -> float:
+        """Convert a command level from model units to the recording's units."""
+        a, b = self.command_scale
+        return a * value_model_units + b
+
+    @property
+    def cmd_unit(self) -> str:
+        """Command unit for messages (``cmd`` when unknown)."""
+        return self.command_unit or 'cmd'
+
+    @property
+    def meas_unit(self) -> str:
+        """Measurement unit for messages (``units`` when unknown)."""
+        return self.measurement_unit or 'units'
+
+
+class Mechanism:
+    """Base class: a block that is the identity until a subclass overrides a hook.
+
+    Attributes
+    ----------
+    id : str
+        Mechanism id as the diagnosis issue lists it.
+    title : str
+        A few words naming the physics.
+    stage : str
+        One of :data:`STAGES`, where the block sits.
+    placement : str
+        Where in the chain, in words.
+    names, units : tuple of str
+        Searched parameters and their units.
+    n_linear : int
+        Extra linear parameters profiled with the calibration.
+    smooth : bool
+        Whether the cost is smooth enough in ``theta`` for least squares
+        (else ``theta`` is searched on a grid / pattern search).
+    """
+
+    id = ''  # noqa: A003 - the issue's word for a mechanism's name
+    title = ''
+    stage = 'output'
+    placement = ''
+    physics = ''
+    names: tuple[str, ...] = ()
+    units: tuple[str, ...] = ()
+    n_linear = 0
+    smooth = True
+
+    # -- fitting -----------------------------------------------------------
+    def bounds(self, ctx: Context) -> np.ndarray:
+        """``(len(names), 2)`` bounds of ``theta``."""
+        return np.zeros((0, 2))
+
+    def starts(self, ctx: Context) -> list[np.ndarray]:
+        """Starting values of ``theta`` for the local fits (a coarse grid)."""
+        return [np.zeros(0)]
+
+    def grid(self, ctx: Context) -> list[np.ndarray]:
+        """Dense grid of ``theta`` for blocks that are not smooth (default: the starts)."""
+        return self.starts(ctx)
+
+    def null(self, ctx: Context) -> np.ndarray:
+        """``theta`` at which the block is the identity (the baseline)."""
+        return np.zeros(0)
+
+    # -- stage hooks (identity by default) ----------------------------------
+    def command(self, theta: np.ndarray, t_s: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """Transform the command before the actuator."""
+        return v
+
+    def actuator(self, theta: np.ndarray, x_chain: np.ndarray, t_s: np.ndarray,
+                 v: np.ndarray) -> np.ndarray | None:
+        """Replace the actuator ``B(H(v))``; ``None`` keeps the paper's."""
+        return None
+
+    def position(self, theta: np.ndarray, x: np.ndarray, span: tuple[float, float]
+                 ) -> np.ndarray:
+        """Transform the actuator position; ``span`` is the training travel (lo, hi)."""
+        return x
+
+    def quantity(self, theta: np.ndarray, x: np.ndarray, span: tuple[float, float]
+                 ) -> list[np.ndarray] | None:
+        """Basis of the sensed quantity as a function of position (``None``: ``[x]``)."""
+        return None
+
+    def sensor(self, theta: np.ndarray, t_s: np.ndarray, s: np.ndarray) -> np.ndarray:
+        """Extra sensor dynamics after the modelled ones."""
+        return s
+
+    def output(self, theta: np.ndarray, t_s: np.ndarray, columns: list[np.ndarray],
+               ctx: Context) -> list[np.ndarray]:
+        """Regressors of the linear calibration (last one is the constant)."""
+        return columns
+
+    # -- words -------------------------------------------------------------
+    def describe(self, theta: np.ndarray, coef: np.ndarray, info: dict,
+                 ctx: Context) -> dict[str, Quantity]:
+        """Fitted values with units; ``info`` holds the fit's calibration and travel."""
+        return {n: Quantity(float(v), u) for n, v, u in zip(self.names, theta, self.units)}
+
+    def explain(self, values: dict[str, Quantity], where: dict, ctx: Context) -> str:
+        """One or two sentences a control engineer can act on."""
+        return self.title
+
+    def evidence(self, loc: Any) -> tuple[float, dict]:
+        """Score in [0, 1] of how well the located mismatch fits this physics, and where."""
+        return 0.0, {}
+
+
+def clip_theta(theta: Sequence[float], bounds: np.ndarray) -> np.ndarray:
+    """Clip a parameter vector into its bounds (strictly inside)."""
+    t = np.asarray(theta, dtype=float)
+    lo, hi = bounds[:, 0], bounds[:, 1]
+    eps = 1e-9 * np.maximum(1.0, np.abs(hi - lo))
+    return np.minimum(np.maximum(t, lo + eps), hi - eps)
