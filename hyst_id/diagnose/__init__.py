@@ -48,7 +48,7 @@ from hyst_id.diagnose.mechanisms import get_mechanisms, MECHANISM_IDS
 from hyst_id.diagnose.mechanisms.base import Context, Mechanism, Quantity
 from hyst_id.diagnose.model import ComposedModel
 from hyst_id.diagnose.select import (choose, compare, Comparison, Criteria, Data, evaluate,
-                                     fit_model, FitResult, polish)
+                                     fit_model, FitResult, polish, round_record)
 from hyst_id.errors import ConfigError, RecordingError
 from hyst_id.io.recording import Recording, validate_recording
 
@@ -389,13 +389,7 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
             say(f'round {round_no + 1}: testing {m.id}')
             comps.append(_try(m, current, data, ctx, settings, loc, chain_starts))
         winner, tied = choose(comps, data, settings.criteria)
-        rounds.append({'round': round_no + 1, 'candidates': [
-            {'mechanism': c.mechanism, 'status': c.status, 'chosen': c is winner,
-             'er_train_percent': c.fit.er_train_percent,
-             'er_holdout_percent': c.fit.er_holdout_percent, 'delta_bic': c.delta_bic,
-             'holdout_z': c.holdout_z, 'holdout_gain': c.gain, 'explained_share': c.share,
-             'evidence': c.evidence}
-            for c in comps]})
+        rounds.append(round_record(round_no + 1, comps, winner))
         if winner is None:
             break
         mech = next(m for m in mechs if m.id == winner.mechanism)

@@ -57,7 +57,7 @@ from hyst_id.diagnose.mechanisms.base import clip_theta, Mechanism
 from hyst_id.diagnose.model import ComposedModel, solve_linear
 
 __all__ = ['Criteria', 'Data', 'FitResult', 'Comparison', 'evaluate', 'fit_model', 'polish',
-           'compare', 'choose', 'explained_share', 'improvement_z']
+           'compare', 'choose', 'explained_share', 'improvement_z', 'round_record']
 
 
 @dataclass(frozen=True)
@@ -373,3 +373,14 @@ def choose(comparisons: list[Comparison], data: Data, criteria: Criteria
     close = [c for c in tied if bics[c.mechanism] < low + 2.0]
     winner = max(close, key=lambda c: (c.evidence, -bics[c.mechanism]))
     return winner, [c for c in tied if c is not winner]
+
+
+def round_record(round_no: int, comps: list[Comparison], winner: Comparison | None) -> dict:
+    """JSON record of one selection round: every candidate with its criteria."""
+    return {'round': round_no, 'candidates': [
+        {'mechanism': c.mechanism, 'status': c.status, 'chosen': c is winner,
+         'er_train_percent': c.fit.er_train_percent,
+         'er_holdout_percent': c.fit.er_holdout_percent, 'delta_bic': c.delta_bic,
+         'holdout_z': c.holdout_z, 'holdout_gain': c.gain, 'explained_share': c.share,
+         'evidence': c.evidence}
+        for c in comps]}

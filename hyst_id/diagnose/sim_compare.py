@@ -57,7 +57,8 @@ from hyst_id.diagnose import (DiagnoseSettings, Diagnosis, Finding, floor_percen
                               located_where, range_note, split_index)
 from hyst_id.diagnose.locate import Localization, locate, noise_std, reversal_times
 from hyst_id.diagnose.mechanisms import MECHANISMS, Quantity
-from hyst_id.diagnose.select import choose, compare, Comparison, Data, FitResult
+from hyst_id.diagnose.select import (choose, compare, Comparison, Data, FitResult,
+                                     round_record)
 from hyst_id.errors import ConfigError, HystIdError, RecordingError
 from hyst_id.io.recording import Recording, validate_recording
 
@@ -305,13 +306,7 @@ def _diagnose_sim(recording, base, settings, say):
             comps.append(comp)
             spaces[mid] = (obj, theta)
         winner, tied = choose(comps, data, settings.criteria)
-        rounds.append({'round': round_no + 1, 'candidates': [
-            {'mechanism': c.mechanism, 'status': c.status, 'chosen': c is winner,
-             'er_train_percent': c.fit.er_train_percent,
-             'er_holdout_percent': c.fit.er_holdout_percent, 'delta_bic': c.delta_bic,
-             'holdout_z': c.holdout_z, 'holdout_gain': c.gain, 'explained_share': c.share,
-             'evidence': c.evidence}
-            for c in comps]})
+        rounds.append(round_record(round_no + 1, comps, winner))
         if winner is None:
             break
         obj, theta = spaces[winner.mechanism]
