@@ -167,8 +167,11 @@ def quantum(measurement: np.ndarray) -> float:
 def noise_std(measurement: np.ndarray) -> float:
     """Standard deviation of white measurement noise, robust to quantisation and jumps.
 
-    As :func:`hyst_id.noise.estimate_noise_std`: the median absolute deviation
-    of the differences of order 1, 2 and 3 (``Var = C(2d, d) sigma^2`` for
+    Unlike :func:`hyst_id.noise.estimate_noise_std` (a trimmed RMS that drops
+    only the largest 5 % of the differences), this takes the median absolute
+    deviation of the differences of order 1, 2 and 3, so that a stick-slip
+    recording, where up to half the differences can be jumps, is still read
+    right (``Var = C(2d, d) sigma^2`` for
     white noise), the smallest of the three (a smooth signal inflates the
     low orders, kinks and jumps the high ones; the median ignores up to half
     the samples being stick-slip jumps). On A/D-quantised data the MAD of
