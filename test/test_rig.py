@@ -456,5 +456,8 @@ def test_identification_on_default_rig_reaches_its_floor():
     settings = IdentifySettings(seeds=(0, 1), maxiter=200, workers=1)
     pos = identify(run.recording('position'), settings=settings)
     assert pos.er_percent < 0.15
+    # Data-derived domains are wider than the paper's: seeds spread more on this
+    # nonlinear channel (0.44-1.18 %), so take four.
+    settings = IdentifySettings(seeds=(0, 1, 2, 3))
     pres = identify(run.recording('pressure'), settings=settings)
     assert pres.er_percent < 1.0
