@@ -68,3 +68,20 @@ def ros_domain(monkeypatch):
     monkeypatch.setenv('ROS_DOMAIN_ID', domain)
     monkeypatch.setenv('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
     return int(domain)
+
+
+@pytest.fixture
+def ctx(ros_domain, tmp_path, monkeypatch):
+    """A fresh rclpy context (own domain) and a list of nodes destroyed at teardown.
+
+    ROS_HOME points into the test's tmp dir. Skipped where rclpy is missing.
+    """
+    rclpy = pytest.importorskip('rclpy')
+    monkeypatch.setenv('ROS_HOME', str(tmp_path / 'ros_home'))
+    context = rclpy.Context()
+    rclpy.init(context=context)
+    nodes: list = []
+    yield context, nodes
+    for node in nodes:
+        node.destroy_node()
+    context.try_shutdown()

@@ -56,19 +56,6 @@ FAST = [Parameter('seeds', value=1), Parameter('generations', value=30),
         Parameter('compensator_node', value='')]
 
 
-@pytest.fixture
-def ctx(ros_domain, tmp_path, monkeypatch):
-    """A fresh rclpy context (own domain); ROS_HOME in the test's tmp dir."""
-    monkeypatch.setenv('ROS_HOME', str(tmp_path / 'ros_home'))
-    context = rclpy.Context()
-    rclpy.init(context=context)
-    nodes: list[Node] = []
-    yield context, nodes
-    for node in nodes:
-        node.destroy_node()
-    context.try_shutdown()
-
-
 def _make(ctx, cls, *args, **kwargs):
     node = cls(*args, context=ctx[0], **kwargs)
     ctx[1].append(node)

@@ -58,19 +58,6 @@ pytestmark = pytest.mark.ros
 PAPER = {**PAPER_HYSTERESIS, 'm_bl': 1.0, 'c_bl': -0.25, 'c_br': 0.25}
 
 
-@pytest.fixture
-def ctx(ros_domain, tmp_path, monkeypatch):
-    """A fresh rclpy context (own domain); ROS_HOME in the test's tmp dir."""
-    monkeypatch.setenv('ROS_HOME', str(tmp_path / 'ros_home'))
-    context = rclpy.Context()
-    rclpy.init(context=context)
-    nodes: list[Node] = []
-    yield context, nodes
-    for node in nodes:
-        node.destroy_node()
-    context.try_shutdown()
-
-
 def _make(ctx, cls, *args, **kwargs):
     context, nodes = ctx
     node = cls(*args, context=context, **kwargs)
