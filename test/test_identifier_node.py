@@ -167,6 +167,7 @@ def test_cancel_service_and_parameter_keep_the_last_parameters(ctx, tmp_path):
     ident, out = _recovered(ctx, tmp_path, seeds=40, refine=False)
     before = out.read_bytes()
     got = _listen(ctx)
+    assert _spin_until(ctx, lambda: bool(got), timeout=10.0)   # the recovered, latched doc
     caller = _make(ctx, Node, 'caller')
     cancel = caller.create_client(Trigger, '/identifier/cancel')
     assert _spin_until(ctx, cancel.service_is_ready, timeout=5.0)
