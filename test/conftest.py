@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import itertools
 import os
+import time
 
 import numpy as np
 import pytest
@@ -85,3 +86,31 @@ def ctx(ros_domain, tmp_path, monkeypatch):
     for node in nodes:
         node.destroy_node()
     context.try_shutdown()
+
+
+def make_node(ctx, cls, *args, **kwargs):
+    """Build a node in the test's context and register it for teardown."""
+    context, nodes = ctx
+    node = cls(*args, context=context, **kwargs)
+    nodes.append(node)
+    return node
+
+
+def spin_nodes_until(context, nodes, predicate, timeout=10.0) -> bool:
+    """Spin ``nodes`` until ``predicate()`` holds or ``timeout`` s pass; return it."""
+    from rclpy.executors import SingleThreadedExecutor
+
+    ex = SingleThreadedExecutor(context=context)
+    for n in nodes:
+        ex.add_node(n)
+    deadline = time.monotonic() + timeout
+    try:
+        while time.monotonic() < deadline:
+            if predicate():
+                return True
+            ex.spin_once(timeout_sec=0.02)
+        return predicate()
+    finally:
+        for n in nodes:
+            ex.remove_node(n)
+        ex.shutdown()

@@ -27,14 +27,13 @@
 from __future__ import annotations
 
 import json
-import time
 
+from conftest import make_node, spin_nodes_until
 import numpy as np
 import pytest
 
 rclpy = pytest.importorskip('rclpy')
 
-from rclpy.executors import SingleThreadedExecutor  # noqa: E402
 from rclpy.node import Node  # noqa: E402
 from rclpy.parameter import Parameter  # noqa: E402
 from std_msgs.msg import String  # noqa: E402
@@ -56,27 +55,11 @@ FAST = [Parameter('seeds', value=1), Parameter('generations', value=30),
         Parameter('compensator_node', value='')]
 
 
-def _make(ctx, cls, *args, **kwargs):
-    node = cls(*args, context=ctx[0], **kwargs)
-    ctx[1].append(node)
-    return node
+_make = make_node
 
 
 def _spin_until(ctx, predicate, timeout=10.0):
-    ex = SingleThreadedExecutor(context=ctx[0])
-    for n in ctx[1]:
-        ex.add_node(n)
-    deadline = time.monotonic() + timeout
-    try:
-        while time.monotonic() < deadline:
-            if predicate():
-                return True
-            ex.spin_once(timeout_sec=0.02)
-        return predicate()
-    finally:
-        for n in ctx[1]:
-            ex.remove_node(n)
-        ex.shutdown()
+    return spin_nodes_until(ctx[0], ctx[1], predicate, timeout)
 
 
 def _samples(n=400, dt_ns=50_000_000, drift_per_s=0.0):

@@ -21,14 +21,13 @@ from __future__ import annotations
 
 import json
 import math
-import time
 
+from conftest import make_node, spin_nodes_until
 import numpy as np
 import pytest
 
 rclpy = pytest.importorskip('rclpy')
 
-from rclpy.executors import SingleThreadedExecutor  # noqa: E402
 from rclpy.node import Node  # noqa: E402
 from rclpy.parameter import Parameter  # noqa: E402
 from std_msgs.msg import Float64, String  # noqa: E402
@@ -58,28 +57,11 @@ pytestmark = pytest.mark.ros
 PAPER = {**PAPER_HYSTERESIS, 'm_bl': 1.0, 'c_bl': -0.25, 'c_br': 0.25}
 
 
-def _make(ctx, cls, *args, **kwargs):
-    context, nodes = ctx
-    node = cls(*args, context=context, **kwargs)
-    nodes.append(node)
-    return node
+_make = make_node
 
 
 def _spin_until(ctx, nodes, predicate, timeout=10.0):
-    ex = SingleThreadedExecutor(context=ctx[0])
-    for n in nodes:
-        ex.add_node(n)
-    deadline = time.monotonic() + timeout
-    try:
-        while time.monotonic() < deadline:
-            if predicate():
-                return True
-            ex.spin_once(timeout_sec=0.02)
-        return predicate()
-    finally:
-        for n in nodes:
-            ex.remove_node(n)
-        ex.shutdown()
+    return spin_nodes_until(ctx[0], nodes, predicate, timeout)
 
 
 def _set(node, **values):
