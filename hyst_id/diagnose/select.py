@@ -19,7 +19,9 @@ the previous model's parameters, each new block at every point of its
 coarse grid (:meth:`Mechanism.starts`). Smooth blocks get a short bounded
 least-squares run from every start and a full one from the best two;
 non-smooth ones (stiction) are searched on a dense grid, then on finer
-and finer local grids, alternating with least squares on the chain.
+and finer local grids, alternating with least squares on the chain; a
+block can add starts built from the data (:meth:`Mechanism.data_starts`,
+stiction's measured slips), which compete on the training error.
 Linear parameters are profiled on the training samples
 (:mod:`hyst_id.diagnose.model`), and the result is never worse on the
 training part than the model it extends.
@@ -296,7 +298,13 @@ def fit_model(model: ComposedModel, data: Data, p_prev: np.ndarray, new: Mechani
                 nfev += k
             if f < best_f:
                 best_p, best_f = p, f
-    return evaluate(model, data, best_p, nfev)
+    before = obj.nfev
+    for p in new.data_starts(model, data, p_prev, list(chain_starts or [])):
+        if model.feasible(p):
+            f = obj.sse(p)
+            if f < best_f:
+                best_p, best_f = np.array(p, dtype=float), f
+    return evaluate(model, data, best_p, nfev + obj.nfev - before)
 
 
 def improvement_z(pred_before: np.ndarray, pred_after: np.ndarray, y: np.ndarray,

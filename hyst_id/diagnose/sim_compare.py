@@ -59,6 +59,7 @@ from hyst_id.diagnose.locate import Localization, locate, noise_std, reversal_ti
 from hyst_id.diagnose.mechanisms import MECHANISMS, Quantity
 from hyst_id.diagnose.select import (choose, compare, Comparison, Data, FitResult,
                                      round_record)
+from hyst_id.diagnose.stick_events import bands_from_demand
 from hyst_id.errors import ConfigError, HystIdError, RecordingError
 from hyst_id.io.recording import Recording, validate_recording
 
@@ -123,8 +124,8 @@ def _space(mech_id: str, params, channel: str, truth: dict, t: np.ndarray, perio
         return ({'effects.stick_slip.enabled': True},
                 [_Param('effects.stick_slip.static_band', 'position units', 1e-4 * w, 0.2 * w,
                         log=True),
-                 _Param('effects.stick_slip.dynamic_band', 'fraction of static band', 0.0,
-                        0.9)])
+                 # searched as a share of the static band, reported (and written) absolute
+                 _Param('effects.stick_slip.dynamic_band', 'position units', 0.0, 0.9)])
     if mech_id == 'static_nonlinearity':
         if channel == 'position':
             return None
@@ -186,8 +187,13 @@ def _from_unit(p: _Param, u: float) -> float:
     return p.lo + u * (p.hi - p.lo)
 
 
-def _fit_effect(obj: _SimObjective, mech_id: str) -> np.ndarray:
+def _fit_effect(obj: _SimObjective, mech_id: str, demand: np.ndarray | None = None
+                ) -> np.ndarray:
     space = obj.space
+    if mech_id == 'stiction' and obj.channel == 'position' and demand is not None:
+        theta = _stiction_from_events(obj, demand)
+        if theta is not None:
+            return theta
     if mech_id == 'offset_drift':
         pred = obj.predict([0.0])
         tau = obj.t[:obj.n] - obj.t[0]
@@ -217,6 +223,20 @@ def _fit_effect(obj: _SimObjective, mech_id: str) -> np.ndarray:
                                                   'initial_simplex': None})
     u = res.x if res.fun < best_f else best_u
     return np.array([_from_unit(p, x) for p, x in zip(space, u)])
+
+
+def _stiction_from_events(obj: _SimObjective, demand: np.ndarray) -> np.ndarray | None:
+    """Bands from the measured slips (a grid cannot line the staircase up, see stick_events)."""
+    n = obj.n
+    sigma = noise_std(obj.y[:n])
+    bands = bands_from_demand(demand[:n], obj.y[:n], sigma)
+    if bands is None:
+        return None
+    static, dynamic = bands
+    lo, hi = obj.space[0].lo, obj.space[0].hi
+    if not lo <= static <= hi:
+        return None
+    return np.array([static, dynamic / static])
 
 
 def _result(ids, theta, pred, y, n_train) -> FitResult:
@@ -295,7 +315,7 @@ def _diagnose_sim(recording, base, settings, say):
                 continue
             say(f'round {round_no + 1}: switching on {mid} in the simulator')
             obj = _SimObjective(params, space[0], space[1], t, v, y, n_train, ch)
-            theta = _fit_effect(obj, mid)
+            theta = _fit_effect(obj, mid, truth['backlash_out'])
             pred = obj.predict(theta)
             if pred is None:
                 continue

@@ -26,7 +26,7 @@ id                          placed                                      searched
 ``supply_decay``            gain in time on the sensed quantity         decay rate
 ``offset_drift``            added to the measurement                    (linear)
 ``saturation``              clip of the actuator position               two stops
-``stiction``                stick-slip on the actuator position         two bands
+``stiction``                stick-slip on the actuator position         band, start
 ``static_nonlinearity``     position -> sensed quantity map             (linear)
 ``rate_dependence``         loop width inside H grows with rate         width, filter
 ==========================  ==========================================  ============

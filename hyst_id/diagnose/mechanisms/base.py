@@ -172,6 +172,15 @@ class Mechanism:
         """``theta`` at which the block is the identity (the baseline)."""
         return np.zeros(0)
 
+    def data_starts(self, model: Any, data: Any, p_prev: np.ndarray,
+                    chain_starts: list[np.ndarray]) -> list[np.ndarray]:
+        """Full parameter vectors of ``model`` built from the measured data (default: none).
+
+        For blocks whose fit cannot start from the baseline (stiction): these
+        are scored with the grid's candidates and kept as they are when best.
+        """
+        return []
+
     # -- stage hooks (identity by default) ----------------------------------
     def command(self, theta: np.ndarray, t_s: np.ndarray, v: np.ndarray) -> np.ndarray:
         """Transform the command before the actuator."""

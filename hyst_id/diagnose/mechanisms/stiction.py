@@ -14,47 +14,59 @@
 
 """``stiction``: stick-slip friction in the actuator.
 
-Placement: on the actuator position, after B, before the end stops:
-the position stays put while the drive's demand is within the static band
-of it; once beyond, it slips to the dynamic band short of the demand (the
-two-parameter stick-slip model used for control valves). A ramp becomes a
-staircase with steps of ``static - dynamic``. Both bands are searched as
-fractions of the training travel; because the cost is piecewise constant in
-them (the staircase jumps), they are found on a dense grid and then on
-finer local grids, alternating with least squares on the chain.
+Placement: on the actuator position, after B, before the end stops: the
+position stays put while the demand ``x = B(H(v))`` is within ``band`` of
+it; once beyond, it slips onto the demand. A slow ramp becomes a staircase
+with steps of ``band``. The common two-parameter model also has a dynamic
+band (the actuator slips to ``dynamic`` short of the demand); that is
+exactly a backlash ``dynamic`` wider ahead of a zero dynamic band, so the
+chain's backlash carries it and only the slip band is searched. The
+initial stuck position (its offset from the initial demand) is the block's
+second parameter: the staircase never forgets where it started.
 
-Signature: residual largest when the command moves slowly, saw-tooth
-shaped, with power above the command's harmonics.
+Fitting: the simulated staircase lines up with the measured one only within
+about 0.3 % of the exact parameters, so the block's starts come from the
+measured events (:mod:`hyst_id.diagnose.stick_events`: plateau levels,
+slip samples, and the stick and slip conditions, fitted together with the
+chain). A dense grid over the band remains as a fallback for records that
+are not a clean staircase.
+
+Signature: the measurement holds still while the model moves; residual
+largest when the command moves slowly, saw-tooth shaped.
 """
 
 from __future__ import annotations
 
-import math
+from typing import Any
 
 from numba import njit
 import numpy as np
 
 from hyst_id.diagnose.mechanisms.base import Context, Mechanism, Quantity
+from hyst_id.diagnose.stick_events import fit_stick_slip_events
 
 __all__ = ['Stiction', 'MECHANISM', 'stick_slip']
 
 
 @njit(cache=True)
-def stick_slip(x: np.ndarray, static_band: float, dynamic_band: float) -> np.ndarray:
-    """Position after stick-slip friction for a demanded position ``x``."""
+def stick_slip(x: np.ndarray, band: float, stuck0: float) -> np.ndarray:
+    """Position after stick-slip friction for a demanded position ``x``.
+
+    Stays while ``|x - position| <= band``, else slips onto ``x``; starts
+    stuck at ``stuck0``.
+    """
     out = np.empty(x.shape[0])
-    out[0] = x[0]
+    out[0] = stuck0
     for j in range(1, x.shape[0]):
-        d = x[j] - out[j - 1]
-        if abs(d) <= static_band:
+        if abs(x[j] - out[j - 1]) <= band:
             out[j] = out[j - 1]
         else:
-            out[j] = x[j] - math.copysign(dynamic_band, d)
+            out[j] = x[j]
     return out
 
 
 class Stiction(Mechanism):
-    """Two-parameter stick-slip on the actuator position."""
+    """Stick-slip on the actuator position: slip band and initial stuck offset."""
 
     id = 'stiction'  # noqa: A003
     title = 'stick-slip friction in the actuator'
@@ -62,23 +74,40 @@ class Stiction(Mechanism):
     placement = 'on the actuator position, after the backlash B, before the end stops'
     physics = ('static friction holds the actuator until the drive force exceeds it, then the '
                'actuator slips: a ramp becomes a staircase')
-    names = ('static_band_fraction', 'dynamic_ratio')
+    names = ('band_fraction', 'initial_offset_fraction')
     units = ('1', '1')
     smooth = False
 
     def bounds(self, ctx: Context) -> np.ndarray:
-        """Static band up to 20 % of the travel; dynamic band below the static one."""
-        return np.array([[0.0, 0.2], [0.0, 0.95]])
+        """Band up to 20 % of the travel; initial offset within +-20 % of it."""
+        return np.array([[0.0, 0.2], [-0.2, 0.2]])
 
     def starts(self, ctx: Context) -> list[np.ndarray]:
-        """Static bands 0.3 to 10 % of the travel, dynamic 0, 50 and 80 % of it."""
-        return [np.array([s, d]) for s in (0.003, 0.006, 0.012, 0.025, 0.05, 0.1)
-                for d in (0.0, 0.5, 0.8)]
+        """Bands 0.3 to 10 % of the travel, starting on the demand."""
+        return [np.array([s, 0.0]) for s in (0.003, 0.006, 0.012, 0.025, 0.05, 0.1)]
 
     def grid(self, ctx: Context) -> list[np.ndarray]:
-        """80 static bands (0.2 to 20 % of the travel, log-spaced) x 10 dynamic ratios."""
-        return [np.array([s, d]) for s in np.geomspace(0.002, 0.2, 80)
-                for d in np.linspace(0.0, 0.9, 10)]
+        """200 bands (0.2 to 20 % of the travel, log-spaced) x 3 initial offsets."""
+        return [np.array([s, f * s]) for s in np.geomspace(0.002, 0.2, 200)
+                for f in (-0.5, 0.0, 0.5)]
+
+    def data_starts(self, model: Any, data: Any, p_prev: np.ndarray,
+                    chain_starts: list[np.ndarray]) -> list[np.ndarray]:
+        """Chain and block from the measured plateaus and slips (position records only)."""
+        if model.channel != 'position' or model.ids != (self.id,):
+            return []
+        n = data.n_train
+        chains = [np.asarray(p_prev[:model.n_chain])]
+        chains += [np.asarray(c[:model.n_chain]) for c in chain_starts]
+        fits = fit_stick_slip_events(model.spec, data.t_s[:n], data.v[:n], data.y[:n],
+                                     data.noise_std, chains)
+        out = []
+        for f in fits[:4]:
+            p = np.array(p_prev, dtype=float)
+            p[:model.n_chain] = f.chain
+            p[model.slices[self.id]] = (f.band_fraction, f.offset_fraction)
+            out.append(p)
+        return out
 
     def null(self, ctx: Context) -> np.ndarray:
         """No stiction."""
@@ -86,41 +115,40 @@ class Stiction(Mechanism):
 
     def position(self, theta, x, span) -> np.ndarray:
         """Stick-slip on the position."""
-        s = float(theta[0]) * (span[1] - span[0])
-        if s <= 0.0:
+        travel = span[1] - span[0]
+        band = float(theta[0]) * travel
+        if band <= 0.0:
             return x
-        return stick_slip(np.ascontiguousarray(x), s, float(theta[1]) * s)
+        return stick_slip(np.ascontiguousarray(x), band, float(x[0] + theta[1] * travel))
 
     def describe(self, theta, coef, info, ctx) -> dict[str, Quantity]:
-        """Bands in measurement units, % of travel and command equivalents."""
+        """Slip band in measurement units, % of travel and command equivalent."""
         lo, hi = info['span']
-        s_pos = float(theta[0]) * (hi - lo)
-        d_pos = float(theta[1]) * s_pos
+        band = float(theta[0]) * (hi - lo)
         gain = info['meas_per_pos']
         per_cmd = info['pos_per_cmd']
-        out = {}
-        for name, band, words in (('static_band', s_pos, 'demand needed to break away'),
-                                  ('dynamic_band', d_pos, 'demand left after a slip'),
-                                  ('slip_jump', s_pos - d_pos, 'size of each slip')):
-            out[name] = Quantity(abs(gain) * band, ctx.meas_unit, words + ', as measured')
-            if per_cmd:
-                out[name + '_command'] = Quantity(band / abs(per_cmd), ctx.cmd_unit,
-                                                  words + ', in command')
-        out['static_band_percent'] = Quantity(100.0 * float(theta[0]), '%',
-                                              'static band as a share of the travel')
+        out = {'slip_band': Quantity(abs(gain) * band, ctx.meas_unit,
+                                     'demand beyond the stuck position needed to break away '
+                                     '(= size of each slip), as measured')}
+        if per_cmd:
+            out['slip_band_command'] = Quantity(band / abs(per_cmd), ctx.cmd_unit,
+                                                'the same band in command')
+        out['slip_band_percent'] = Quantity(100.0 * float(theta[0]), '%',
+                                            'slip band as a share of the travel')
+        out['initial_offset'] = Quantity(gain * float(theta[1]) * (hi - lo), ctx.meas_unit,
+                                         'stuck position at the start minus the demand')
         return out
 
     def explain(self, values, where, ctx) -> str:
         """Words for a control engineer."""
-        s = values['static_band']
-        j = values['slip_jump']
-        cmd = values.get('static_band_command')
+        s = values['slip_band']
+        cmd = values.get('slip_band_command')
         cmd_words = f' (about {cmd.value:.3g} {cmd.unit} of command)' if cmd else ''
         return (f'The actuator sticks: it holds still until the demand has moved {s.value:.3g} '
-                f'{s.unit}{cmd_words} away, then slips in jumps of {j.value:.3g} {j.unit}: '
-                'stick-slip friction in the drive or the valve packing. Expect limit cycles '
-                'under integral control; use friction compensation (knocker, dither) or '
-                'service the actuator.')
+                f'{s.unit}{cmd_words} away, then slips onto it in one jump: stick-slip '
+                'friction in the drive or the valve packing (any dynamic band of the friction '
+                'is carried by the backlash). Expect limit cycles under integral control; use '
+                'friction compensation (knocker, dither) or service the actuator.')
 
     def evidence(self, loc) -> tuple[float, dict]:
         """Measurement holding still while the model moves; residual largest at slow motion."""
