@@ -72,6 +72,10 @@ class IdentifySettings:
         ``restart_factor`` times the estimated noise floor (refinement on only).
     restart_factor : float
         Restarts stop once %e_r is within this factor of the noise floor.
+    restart_patience : int
+        Restarts also stop after this many in a row that lower the cost by
+        less than 1 % (the floor is out of reach of the model: real data with
+        unmodelled physics would otherwise always pay for every restart).
     er_bound_percent : float or None
         Stop a GAASS run early once %e_r falls below this bound.
     """
@@ -87,6 +91,7 @@ class IdentifySettings:
     refine_top: int = 3
     restarts: int = 4
     restart_factor: float = 1.05
+    restart_patience: int = 2
     er_bound_percent: float | None = None
 
 
@@ -200,7 +205,8 @@ def run_seed(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray, measurement:
     refinement on, the ``refine_top`` best distinct chromosomes of the final
     population are polished and the best kept; while %e_r stays above
     ``restart_factor`` times the noise floor, GAASS restarts with a seed
-    derived from ``(seed, restart)``, up to ``restarts`` times.
+    derived from ``(seed, restart)``, up to ``restarts`` times, or until
+    ``restart_patience`` restarts in a row gain less than 1 %.
     """
     with threadpool_limits(limits=1):   # parallelism is over seeds, not inside BLAS
         return _run_seed(spec, t_s, command, measurement, settings, seed, floor_percent)
@@ -215,6 +221,7 @@ def _run_seed(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray, measurement
         target = (settings.er_bound_percent / 100.0) ** 2 * sum_sq
     good_enough = (settings.restart_factor * floor_percent / 100.0) ** 2 * sum_sq
     best_x, best_fun, er_ga, nfev, nit, history, message = None, np.inf, np.nan, 0, 0, None, ''
+    stalled = 0
     for restart in range(1 + (settings.restarts if settings.refine else 0)):
         rng = seed if restart == 0 else np.random.default_rng([seed, restart])
         solver = GaassSolver(cost, spec.bounds, feasible=spec.feasible,
@@ -234,10 +241,14 @@ def _run_seed(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray, measurement
                                                   max_nfev=settings.refine_max_nfev)
                 nfev += nfev_ref
                 candidates.append((x_ref, fun_ref))
+        previous = best_fun
         for x, fun in candidates:
             if fun < best_fun:
                 best_x, best_fun = x, fun
         if best_fun <= good_enough or (target is not None and best_fun <= target):
+            break
+        stalled = stalled + 1 if restart and best_fun > 0.99 * previous else 0
+        if stalled >= settings.restart_patience:
             break
     k, b = spec.fit_calibration(best_x, t_s, command, measurement)
     if k == 0:

@@ -115,3 +115,18 @@ def test_negative_gain_sensor_is_identified_with_output_sign():
     y_fit = ident.spec().simulate(ident.x, rec.t_s, rec.command)
     noise_rms = np.sqrt(np.mean((rec.measurement - y_true) ** 2))
     assert np.sqrt(np.mean((y_fit - (3000.0 - y_true)) ** 2)) < 0.35 * noise_rms
+
+
+def test_restarts_stop_when_they_stop_gaining(simulated):
+    """Unmodelled physics (here a slow drift) keeps %e_r off the floor: restarts stop early."""
+    rec, _ = simulated('position')
+    drift = 0.05 * np.sin(2 * np.pi * rec.t_s / 37.0) * np.ptp(rec.measurement)
+    off = Recording(rec.t_s, rec.command, rec.measurement + drift, 'position', 'mA', '',
+                    'position with an unmodelled drift')
+    base = {'seeds': (0,), 'workers': 1, 'maxiter': 60, 'restarts': 4}
+    full = identify(off, settings=IdentifySettings(**base, restart_patience=100)).runs[0]
+    capped = identify(off, settings=IdentifySettings(**base, restart_patience=1)).runs[0]
+    assert full.er_percent > 1.5 * noise_floor_percent(off.measurement)   # restarts wanted
+    assert full.nit == 5 * 60          # every restart ran
+    assert capped.nit < full.nit       # stopped at the first restart that did not gain
+    assert capped.nit % 60 == 0

@@ -93,7 +93,7 @@ PARAMS = [
           'process per core; n > 1: n processes', low=0, high=1024),
     Param('refine', True, 'polish each GAASS result with bounded least squares'),
     Param('restarts', 4, 'extra GAASS runs per seed while %e_r stays above 1.05 x the noise '
-          'floor (0 = one run per seed)', low=0, high=1000),
+          'floor and they still gain (0 = one run per seed)', low=0, high=1000),
     Param('er_bound_percent', 0.0, 'stop a GAASS run once %e_r is below this (0 = never)',
           low=0.0, high=1000.0, unit='%'),
     Param('domains', 'auto', "search domains: 'auto' (from the data), 'paper', or a YAML "
