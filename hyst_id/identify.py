@@ -30,7 +30,7 @@ from dataclasses import asdict, dataclass, field
 import multiprocessing
 import os
 import threading
-from typing import Callable
+from typing import Any, Callable
 
 import numpy as np
 from threadpoolctl import threadpool_limits
@@ -198,7 +198,8 @@ class Identification:
 
 
 def run_seed(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray, measurement: np.ndarray,
-             settings: IdentifySettings, seed: int, floor_percent: float = 0.0) -> SeedRun:
+             settings: IdentifySettings, seed: int, floor_percent: float = 0.0,
+             on_generation: Callable[[int, int, int, float], Any] | None = None) -> SeedRun:
     """Identify with one seed: GAASS, refinement, restarts; picklable for workers.
 
     The first GAASS run uses ``seed`` itself (the paper's procedure). With
@@ -207,13 +208,17 @@ def run_seed(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray, measurement:
     ``restart_factor`` times the noise floor, GAASS restarts with a seed
     derived from ``(seed, restart)``, up to ``restarts`` times, or until
     ``restart_patience`` restarts in a row gain less than 1 %.
+    ``on_generation(seed, restart, generation, er_percent)`` is called after
+    every GAASS generation (it may raise to abandon the seed).
     """
     with threadpool_limits(limits=1):   # parallelism is over seeds, not inside BLAS
-        return _run_seed(spec, t_s, command, measurement, settings, seed, floor_percent)
+        return _run_seed(spec, t_s, command, measurement, settings, seed, floor_percent,
+                         on_generation)
 
 
 def _run_seed(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray, measurement: np.ndarray,
-              settings: IdentifySettings, seed: int, floor_percent: float) -> SeedRun:
+              settings: IdentifySettings, seed: int, floor_percent: float,
+              on_generation: Callable[[int, int, int, float], Any] | None) -> SeedRun:
     cost = spec.cost_function(t_s, command, measurement)
     sum_sq = float(np.sum(measurement ** 2))
     target = None
@@ -226,7 +231,8 @@ def _run_seed(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray, measurement
         rng = seed if restart == 0 else np.random.default_rng([seed, restart])
         solver = GaassSolver(cost, spec.bounds, feasible=spec.feasible,
                              pop_size=settings.pop_size, maxiter=settings.maxiter, c=settings.c,
-                             xi=settings.xi, target=target, rng=rng)
+                             xi=settings.xi, target=target, rng=rng,
+                             callback=_report(on_generation, seed, restart, measurement))
         res = solver.solve()
         nfev += int(res.nfev)
         nit += int(res.nit)
@@ -259,6 +265,17 @@ def _run_seed(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray, measurement
                    fun=float(best_fun),
                    er_percent=float(er_percent(best_fun, measurement)), er_gaass_percent=er_ga,
                    nfev=nfev, nit=nit, best_history=history, message=message)
+
+
+def _report(on_generation: Callable[[int, int, int, float], Any] | None, seed: int,
+            restart: int, measurement: np.ndarray) -> Callable[[Any], None] | None:
+    """GAASS callback that hands each generation to ``on_generation`` (None: none)."""
+    if on_generation is None:
+        return None
+
+    def callback(res: Any) -> None:
+        on_generation(seed, restart, int(res.nit), float(er_percent(res.fun, measurement)))
+    return callback
 
 
 def _distinct_best(pop: np.ndarray, fun: np.ndarray, count: int) -> list[np.ndarray]:
@@ -295,7 +312,9 @@ def _n_workers(settings: IdentifySettings) -> int:
 
 def identify(recording: Recording, *, spec: ChainSpec | None = None,
              settings: IdentifySettings | None = None,
-             progress: Callable[[int, int, SeedRun], None] | None = None) -> Identification:
+             progress: Callable[[int, int, SeedRun], None] | None = None,
+             on_generation: Callable[[int, int, int, float], Any] | None = None
+             ) -> Identification:
     """Identify the chain of ``recording.channel`` from a recording.
 
     Parameters
@@ -310,6 +329,10 @@ def identify(recording: Recording, *, spec: ChainSpec | None = None,
         GAASS and refinement settings; default the paper's.
     progress : callable, optional
         Called as ``progress(done, total, seed_run)`` after each seed.
+    on_generation : callable, optional
+        Called as ``on_generation(seed, restart, generation, er_percent)``
+        after every GAASS generation, when the seeds run in this process
+        (``workers == 1``; worker processes report per seed only).
 
     Returns
     -------
@@ -329,7 +352,7 @@ def identify(recording: Recording, *, spec: ChainSpec | None = None,
     n_workers = _n_workers(settings)
     if n_workers == 1:
         for seed in settings.seeds:
-            runs.append(run_seed(*args, seed, floor))
+            runs.append(run_seed(*args, seed, floor, on_generation))
             if progress:
                 progress(len(runs), len(settings.seeds), runs[-1])
     else:

@@ -274,10 +274,11 @@ class IdentificationJob(BackgroundJob):
 
     The same function as ``hyst-id identify``, so the same settings and
     seeds give the same result. ``workers == 1`` runs the seeds one after
-    the other in the thread (a cancel stops it after the running seed);
+    the other in the thread (a cancel stops it within a generation);
     otherwise ``identify`` runs them in worker processes and the thread only
     waits (a cancel takes effect when they are done). :meth:`progress` is
-    safe to call from another thread at any time.
+    safe to call from another thread at any time; with ``workers == 1`` it
+    also gives the running seed's GAASS generation.
     """
 
     name = 'identify'
@@ -287,23 +288,35 @@ class IdentificationJob(BackgroundJob):
         self.rec, self.spec, self.settings = rec, spec, settings
         self.seeds = tuple(settings.seeds)
         self.runs: list[SeedRun] = []
+        self.generation: dict[str, Any] = {}
         self.start()
 
     def work(self) -> Identification:
         return identify(self.rec, spec=self.spec, settings=self.settings,
-                        progress=self._progress)
+                        progress=self._progress, on_generation=self._generation)
 
     def _progress(self, done: int, total: int, run: SeedRun) -> None:
         self.runs = self.runs + [run]
         self.check_cancelled()
 
+    def _generation(self, seed: int, restart: int, generation: int, er: float) -> None:
+        self.generation = {'seed': seed, 'restart': restart, 'generation': generation,
+                           'seed_er_percent': er}
+        self.check_cancelled()
+
     def progress(self) -> dict[str, Any]:
-        """Seeds done, best %e_r so far, elapsed time."""
+        """Seeds done, best %e_r so far, elapsed time; the running seed's generation.
+
+        The generation is known when the seeds run in the job's own thread
+        (``workers == 1``); a cancel then stops within one generation.
+        """
         runs = self.runs
         out: dict[str, Any] = {'seeds_done': len(runs), 'seeds': len(self.seeds),
                                'elapsed_s': self.elapsed_s}
         if runs:
             out['best_er_percent'] = min(r.er_percent for r in runs)
+        if self.generation and len(runs) < len(self.seeds):
+            out.update(self.generation)
         return out
 
 

@@ -97,6 +97,23 @@ def test_identification_job_cancels_between_seeds():
     assert 1 <= len(job.runs) < 50
 
 
+def test_identification_job_reports_generations_and_cancels_within_a_seed():
+    ct, cv, mt, mv = _streams()
+    rec = pair_streams(ct, cv, mt, mv, 'position')
+    settings = IdentifySettings(seeds=(0,), maxiter=100000, refine=False, workers=1)
+    job = IdentificationJob(rec, chain_spec('position'), settings)
+    deadline = 60.0
+    while job.progress().get('generation', 0) < 5 and deadline > 0:
+        job.wait(0.05)
+        deadline -= 0.05
+    prog = job.progress()
+    assert prog['seed'] == 0 and prog['restart'] == 0 and prog['generation'] >= 5
+    assert prog['seed_er_percent'] > 0
+    job.cancel()
+    assert job.wait(30.0)            # 100000 generations would take minutes
+    assert job.cancelled and not job.runs
+
+
 def test_background_job_errors_are_one_line():
     class Boom(BackgroundJob):
         def work(self):

@@ -438,6 +438,9 @@ class Identifier(HystNode):
             msg = (f'identifying: {prog["seeds_done"]}/{prog["seeds"]} seeds done, '
                    f'{prog["elapsed_s"]:.1f} s' + (f', best %e_r {prog["best_er_percent"]:.3f}'
                                                    if 'best_er_percent' in prog else ''))
+            if 'generation' in prog:
+                msg += (f'; seed {prog["seed"]} run {prog["restart"] + 1} generation '
+                        f'{prog["generation"]}, %e_r {prog["seed_er_percent"]:.3f}')
         elif self.last_error:
             level, msg = 2, self.last_error
         elif self.last_document:
