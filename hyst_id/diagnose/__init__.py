@@ -440,4 +440,7 @@ def _try(m: Mechanism, current: FitResult, data: Data, ctx: Context,
                     chain_starts=chain_starts)
     comp = compare(current, fit, data, m.id, settings.criteria)
     comp.evidence, comp.where = m.evidence(loc)
+    reason = m.implausible(model.theta(fit.p, m.id), fit.coef, fit.span, data.noise_std)
+    if reason and comp.accepted:
+        comp.accepted, comp.status = False, f'rejected: {reason}'
     return comp

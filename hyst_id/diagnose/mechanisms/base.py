@@ -181,6 +181,16 @@ class Mechanism:
         """
         return []
 
+    def implausible(self, theta: np.ndarray, coef: np.ndarray, span: tuple[float, float],
+                    noise_std: float) -> str:
+        """Why the fitted block cannot be what the data show ('' when it can).
+
+        A block whose own effect is below what the data can resolve (e.g.
+        stick-slip jumps smaller than the noise) may still lower the error by
+        letting the chain refit; that gain is not evidence for the block.
+        """
+        return ''
+
     # -- stage hooks (identity by default) ----------------------------------
     def command(self, theta: np.ndarray, t_s: np.ndarray, v: np.ndarray) -> np.ndarray:
         """Transform the command before the actuator."""

@@ -109,6 +109,18 @@ class Stiction(Mechanism):
             out.append(p)
         return out
 
+    def implausible(self, theta, coef, span, noise_std) -> str:
+        """Slips below twice the noise std are not seen as slips.
+
+        Such a block only lets the chain refit (a tiny band also acts like a
+        sub-sample lag).
+        """
+        jump = abs(float(coef[0])) * float(theta[0]) * (span[1] - span[0])
+        if jump < 2.0 * noise_std:
+            return (f'slip band {jump:.3g} is below twice the noise std ({noise_std:.3g}): '
+                    'no visible slips')
+        return ''
+
     def null(self, ctx: Context) -> np.ndarray:
         """No stiction."""
         return np.zeros(2)
