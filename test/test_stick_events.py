@@ -118,3 +118,17 @@ def test_bands_from_a_known_demand():
     assert got[1] == pytest.approx(dynamic, abs=0.05 * static)
     assert bands_from_demand(x, x + np.random.default_rng(2).normal(0, NOISE, x.size),
                              NOISE) is None
+
+
+def test_slips_of_a_few_noise_std_are_all_found():
+    """Candidate steps at 3 sigma, then merging: 7-sigma slips are all found."""
+    t, v, x = _demand()
+    band = 7.0 * NOISE
+    clean = stick_slip(x, band, x[0])
+    slips = np.nonzero(np.diff(clean))[0] + 1
+    y = clean + np.random.default_rng(5).normal(0.0, NOISE, x.size)
+    p = plateaus(y, NOISE)
+    assert slips.size > 100
+    assert np.array_equal(p.edges[1:-1], slips)
+    single = np.nonzero(np.abs(np.diff(y)) > 5.0 * NOISE)[0] + 1
+    assert not np.array_equal(single, slips)     # one 5-sigma threshold misses some

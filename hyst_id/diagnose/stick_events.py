@@ -59,8 +59,8 @@ from scipy.optimize import least_squares
 
 from hyst_id.chains import ChainSpec
 
-__all__ = ['Plateaus', 'StickSlipFit', 'fit_stick_slip_events', 'plateaus', 'stick_intervals',
-           'bands_from_demand']
+__all__ = ['Plateaus', 'StickSlipFit', 'bands_from_demand', 'fit_stick_slip_events', 'plateaus',
+           'stick_intervals']
 
 
 @dataclass(frozen=True)
@@ -96,9 +96,16 @@ class Plateaus:
                 and self.scatter <= 1.5 * sigma)
 
 
-def plateaus(y: np.ndarray, sigma: float, threshold: float = 5.0,
+def plateaus(y: np.ndarray, sigma: float, threshold: float = 3.0, z_keep: float = 4.0,
              jump_share: float = 0.5) -> Plateaus:
-    """Cut ``y`` at its jumps: steps beyond ``threshold * sigma`` and half the typical jump.
+    """Cut ``y`` into flat stretches at its jumps.
+
+    Candidate cuts are steps beyond ``threshold * sigma`` (so that a slip of
+    a few noise std is rarely missed); neighbouring stretches are then
+    merged, the least different pair first, while their means differ by less
+    than ``z_keep`` standard errors or by less than ``jump_share`` of the
+    median difference (every slip moves by at least the band, so this only
+    drops noise: a 5-sigma spike is rare, not absent).
 
     Parameters
     ----------
@@ -108,29 +115,24 @@ def plateaus(y: np.ndarray, sigma: float, threshold: float = 5.0,
         Measurement noise standard deviation (robust to the jumps, e.g.
         :func:`hyst_id.diagnose.locate.noise_std`).
     threshold : float
-        Jump threshold in noise standard deviations (the difference of two
-        noisy samples has ``sqrt(2) sigma``; 5 gives about one false cut in
-        2500 samples).
+        Candidate step in noise std (a single difference has ``sqrt(2) sigma``).
+    z_keep : float
+        Standard errors by which neighbouring means must differ to stay apart.
     jump_share : float
-        A step must also exceed this share of the median step beyond the
-        noise threshold: every slip moves by at least the band, so this
-        only drops noise spikes (a 5-sigma step is rare, not absent).
+        Share of the median difference between neighbours a cut must reach.
 
     Returns
     -------
     Plateaus
     """
     y = np.asarray(y, dtype=float)
-    step = np.abs(np.diff(y))
-    limit = threshold * max(sigma, 1e-300)
-    big = step[step > limit]
-    if big.size:
-        limit = max(limit, jump_share * float(np.median(big)))
-    cuts = np.nonzero(step > limit)[0] + 1
+    sigma = max(float(sigma), 1e-300)
+    cuts = np.nonzero(np.abs(np.diff(y)) > threshold * sigma)[0] + 1
     edges = np.concatenate([[0], cuts, [y.size]]).astype(np.int64)
+    if cuts.size <= y.size // 2:    # else it moves on most samples: no staircase to refine
+        edges = _merge(edges, np.add.reduceat(y, edges[:-1]), sigma, z_keep, jump_share)
     lengths = np.diff(edges)
-    sums = np.add.reduceat(y, edges[:-1])
-    levels = sums / lengths
+    levels = np.add.reduceat(y, edges[:-1]) / lengths
     dev = y - np.repeat(levels, lengths)
     long_ = np.repeat(lengths >= 3, lengths)
     n_long = int(np.count_nonzero(long_))
@@ -138,6 +140,28 @@ def plateaus(y: np.ndarray, sigma: float, threshold: float = 5.0,
     scatter = float(np.sqrt(np.sum(dev[long_] ** 2) / dof)) if dof > 0 else float('inf')
     return Plateaus(edges=edges, levels=levels, scatter=scatter,
                     held_fraction=n_long / max(y.size, 1))
+
+
+def _merge(edges: np.ndarray, sums: np.ndarray, sigma: float, z_keep: float,
+           jump_share: float) -> np.ndarray:
+    """Merge neighbouring stretches, least different first, until all differ clearly."""
+    starts = list(edges[:-1])
+    counts = list(np.diff(edges).astype(float))
+    totals = list(sums)
+    while len(starts) > 1:
+        n = np.asarray(counts)
+        mean = np.asarray(totals) / n
+        diff = np.abs(np.diff(mean))
+        z = diff / (sigma * np.sqrt(1.0 / n[:-1] + 1.0 / n[1:]))
+        share = diff / max(float(np.median(diff)), 1e-300)
+        weak = np.minimum(z / z_keep, share / jump_share)
+        k = int(np.argmin(weak))
+        if weak[k] >= 1.0:
+            break
+        counts[k] += counts.pop(k + 1)
+        totals[k] += totals.pop(k + 1)
+        starts.pop(k + 1)
+    return np.asarray(starts + [int(edges[-1])], dtype=np.int64)
 
 
 @njit(cache=True)
