@@ -275,6 +275,25 @@ class _EventResidual:
         coef, *_ = np.linalg.lstsq(design, self.plat.levels[1:] * w, rcond=None)
         return coef
 
+    def restart_band(self, q: np.ndarray) -> np.ndarray:
+        """``q`` with band and initial offset re-estimated for its chain.
+
+        Band: the median measured jump in position units; initial stuck
+        position: the first plateau's level.
+        """
+        chain = q[:self.n_chain]
+        if not self.spec.feasible(chain[None, :])[0]:
+            return q
+        x = self.spec.signal(chain, self.t, self.v)
+        travel = float(np.ptp(x)) or 1e-12
+        a, b = self.calibration(x)
+        if a == 0:
+            return q
+        out = np.array(q, dtype=float)
+        out[-2] = float(np.median(np.abs(np.diff(self.plat.levels)))) / abs(a) / travel
+        out[-1] = ((self.plat.levels[0] - b) / a - x[0]) / travel
+        return out
+
     def violations(self, q: np.ndarray) -> int:
         """Stick and slip conditions that ``q`` breaks (no margin)."""
         margin, self.margin = self.margin, 0.0
@@ -405,14 +424,16 @@ def _widen(res: _EventResidual, q: np.ndarray, lo: np.ndarray, hi: np.ndarray,
 
 def _solve(res: _EventResidual, q0: np.ndarray, lo: np.ndarray, hi: np.ndarray,
            weight: float, max_nfev: int) -> np.ndarray | None:
-    """Least squares, then heavier condition weights until no condition is broken.
+    """Levels first, then the conditions, weighted up until none is broken.
 
-    One broken condition is one slip a sample early or late, which puts the
-    simulated staircase out of step for good; the plateau levels can give a
-    little for it.
+    The plateau levels alone are a smooth chain fit; with many conditions
+    broken at the start their hinges pull the chain every way and least
+    squares stalls, so they come in once the levels fit. One broken
+    condition is one slip a sample early or late, which puts the simulated
+    staircase out of step for good; the levels can give a little for it.
     """
     q = q0
-    for factor in (1.0, 10.0, 100.0):
+    for factor in (0.0, 1.0, 10.0, 100.0):
         res.weight = weight * factor
         try:
             q = least_squares(res, np.clip(q, lo, hi), bounds=(lo, hi), method='trf',
@@ -420,7 +441,9 @@ def _solve(res: _EventResidual, q0: np.ndarray, lo: np.ndarray, hi: np.ndarray,
         except (ValueError, np.linalg.LinAlgError):
             res.weight = weight
             return None
-        if res.violations(q) == 0:
+        if factor == 0.0:
+            q = np.clip(res.restart_band(q), lo, hi)
+        elif res.violations(q) == 0:
             break
     res.weight = weight
     return q
