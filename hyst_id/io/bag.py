@@ -58,7 +58,6 @@ import zlib
 
 import numpy as np
 from rosbags.highlevel import AnyReader, AnyReaderError
-from rosbags.interfaces import Nodetype
 from rosbags.rosbag2 import ReaderError, StoragePlugin, Writer, WriterError
 from rosbags.rosbag2.storage_mcap import McapWriter
 from rosbags.serde import SerdeError
@@ -72,6 +71,7 @@ from rosbags.typesys import (
 
 from hyst_id.errors import ConfigError, MissingTopicError, RecordingError
 from hyst_id.io.mcap_recover import lacks_footer, scan_records
+from hyst_id.io.messages import at_path, build_message, merge
 
 if TYPE_CHECKING:
     from rosbags.typesys.store import Typestore
@@ -101,11 +101,6 @@ DEFAULT_START_NS = 1_767_225_600 * 10**9
 
 _READ_ERRORS = (AnyReaderError, ReaderError, SerdeError, TypesysError, OSError, ValueError,
                 TypeError, KeyError, IndexError, EOFError, AssertionError, zlib.error)
-_PRIMITIVE_DTYPES = {
-    'bool': np.bool_, 'byte': np.uint8, 'char': np.uint8, 'int8': np.int8, 'uint8': np.uint8,
-    'int16': np.int16, 'uint16': np.uint16, 'int32': np.int32, 'uint32': np.uint32,
-    'int64': np.int64, 'uint64': np.uint64, 'float32': np.float32, 'float64': np.float64,
-}
 
 
 def default_typestore() -> Typestore:
@@ -253,45 +248,6 @@ class BagWriter:
             except (WriterError, OSError) as exc:
                 self._writer.abort()
                 raise RecordingError(f'cannot finish bag {self.path}: {exc}') from None
-
-
-def build_message(typestore: Typestore, msgtype: str, values: Mapping | None) -> Any:
-    """Build a typestore message from a mapping, filling missing fields with defaults."""
-    values = dict(values or {})
-    _, fields = typestore.fielddefs[msgtype]
-    unknown = set(values) - {name for name, _ in fields}
-    if unknown:
-        raise ConfigError(f'{msgtype} has no field(s) {sorted(unknown)}; '
-                          f'fields: {[name for name, _ in fields]}')
-    kwargs = {name: _build_value(typestore, node, values.get(name)) for name, node in fields}
-    return typestore.types[msgtype](**kwargs)
-
-
-def _build_value(typestore: Typestore, node: tuple, value: Any) -> Any:
-    kind, spec = node
-    if kind == Nodetype.BASE:
-        typ = spec[0]
-        if typ == 'string':
-            return '' if value is None else str(value)
-        if value is None:
-            return False if typ == 'bool' else 0.0 if typ.startswith('float') else 0
-        return float(value) if typ.startswith('float') else bool(value) if typ == 'bool' \
-            else int(value)
-    if kind == Nodetype.NAME:
-        if spec == 'builtin_interfaces/msg/Time' and isinstance(value, (int, np.integer)):
-            sec, nanosec = divmod(int(value), 10**9)
-            return typestore.types[spec](sec=sec, nanosec=nanosec)
-        if value is None or isinstance(value, Mapping):
-            return build_message(typestore, spec, value)
-        return value
-    sub, length = spec
-    items = [] if value is None else list(value)
-    if kind == Nodetype.ARRAY and len(items) < length:
-        items += [None] * (length - len(items))
-    if sub[0] == Nodetype.BASE and sub[1][0] != 'string':
-        dtype = _PRIMITIVE_DTYPES[sub[1][0]]
-        return np.asarray([0 if x is None else x for x in items], dtype=dtype)
-    return [_build_value(typestore, sub, x) for x in items]
 
 
 @dataclass
@@ -467,22 +423,6 @@ def iter_bag_messages(path: str | Path, topics: Sequence[str] | None = None, *,
         yield from bag.messages(topics)
 
 
-def _at_path(tokens: Sequence[str | int], value: float) -> Any:
-    """Nested mapping/list that puts ``value`` at a parsed field path."""
-    if not tokens:
-        return value
-    head, rest = tokens[0], _at_path(tokens[1:], value)
-    if isinstance(head, int):
-        return [None] * head + [rest]
-    return {head: rest}
-
-
-def _merge(a: Any, b: Any) -> Any:
-    if isinstance(a, dict) and isinstance(b, dict):
-        return {**a, **{k: _merge(a[k], v) if k in a else v for k, v in b.items()}}
-    return b
-
-
 def write_recording_bag(path: str | Path, recording: Recording,
                         topics: TopicConfig | None = None, *,
                         start_ns: int = DEFAULT_START_NS,
@@ -532,9 +472,9 @@ def write_recording_bag(path: str | Path, recording: Recording,
             headers[topic] = 'header' in dict(writer.typestore.fielddefs[msgtype][1])
         for i, t_ns in enumerate(stamps.tolist()):
             for topic, msgtype, tokens, values in streams:
-                fields = _at_path(tokens, float(values[i]))
+                fields = at_path(tokens, float(values[i]))
                 if headers[topic]:
-                    fields = _merge({'header': {'stamp': t_ns}}, fields)
+                    fields = merge({'header': {'stamp': t_ns}}, fields)
                 if msgtype == 'sensor_msgs/msg/JointState' and 'name' not in fields:
                     n = max(len(fields.get('position') or ()), 1)
                     fields['name'] = ['actuator'] if n == 1 else [f'actuator_{k}'
