@@ -66,14 +66,19 @@ def loop_width(t_s: np.ndarray, v: np.ndarray, y: np.ndarray) -> float:
     return float(np.clip(np.median(rising) - np.median(falling), 0.02 * span, 0.8 * span))
 
 
+#: (loop width / measured width, share of it given to B) of the data-built starts.
+SPLITS = ((1.0, 0.1), (1.0, 0.5), (0.7, 0.1), (1.4, 0.1))
+
+
 def structured_starts(spec: ChainSpec, t_s: np.ndarray, v: np.ndarray, y: np.ndarray,
-                      sensor: np.ndarray) -> list[np.ndarray]:
+                      sensor: np.ndarray, splits: tuple = SPLITS) -> list[np.ndarray]:
     """Chain starts built from the data: the loop width split between H and B.
 
     Unit side slopes, flat inner lines (slope 0.1), top and bottom lines
     outside the commanded range, the width estimated by :func:`loop_width`
-    given mostly to H, half and half, or mostly to B. Starts outside the
-    search domains or infeasible are dropped.
+    given mostly to H, half and half, or mostly to B (``splits``: pairs of
+    width factor and share of B). Starts outside the search domains or
+    infeasible are dropped.
     """
     lo, hi = float(np.min(v)), float(np.max(v))
     span = hi - lo or 1.0
@@ -81,7 +86,8 @@ def structured_starts(spec: ChainSpec, t_s: np.ndarray, v: np.ndarray, y: np.nda
     mid = 0.5 * (lo + hi)
     shift = mid - 9.0 if not (spec.bounds[6, 0] <= mid <= spec.bounds[6, 1]) else 0.0
     out = []
-    for width, share in ((w, 0.1), (w, 0.5), (0.7 * w, 0.1), (1.4 * w, 0.1)):
+    for factor, share in splits:
+        width = factor * w
         wh, wb = width * (1.0 - share), width * share
         m_t = 0.1
         c_l, c_r = shift - 0.5 * wh, shift + 0.5 * wh

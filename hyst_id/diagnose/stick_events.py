@@ -143,6 +143,12 @@ class StickSlipFit:
         Level plus condition residual sum of squares (measurement units).
     violations : int
         Samples that break a stick or slip condition.
+    slack : float
+        Width of the band interval the conditions allow, relative to the
+        band (0 when they conflict): how far the tightest stick and slip
+        are apart, the room a held-out slip has to land on its sample.
+    band_measured : float
+        The band in measurement units (gauge invariant).
     """
 
     chain: np.ndarray
@@ -150,6 +156,8 @@ class StickSlipFit:
     offset_fraction: float
     cost: float
     violations: int
+    slack: float = 0.0
+    band_measured: float = 0.0
 
 
 class _EventResidual:
@@ -235,8 +243,9 @@ def _narrowed(chain: np.ndarray, jump: float, share: float) -> np.ndarray | None
 def fit_stick_slip_events(spec: ChainSpec, t_s: np.ndarray, v: np.ndarray, y: np.ndarray,
                           sigma: float, chains: Sequence[np.ndarray], *,
                           max_nfev: int = 3000, weight: float = 3.0,
-                          shares: Sequence[float] = (0.5, 0.25, 0.75, 0.0),
-                          widen: int = 3) -> list[StickSlipFit]:
+                          shares: Sequence[float] = (0.5, 0.0),
+                          perturbed: int = 0, keep: int = 64, widen: int = 3,
+                          rng: int = 0) -> list[StickSlipFit]:
     """Fit chain, band and initial state to the plateaus and slips of ``y``.
 
     Parameters
@@ -249,23 +258,32 @@ def fit_stick_slip_events(spec: ChainSpec, t_s: np.ndarray, v: np.ndarray, y: np
         Measurement noise standard deviation.
     chains : sequence of numpy.ndarray
         Chain starts (the baseline fit, data-built starts). Each is tried with
-        its backlash narrowed by ``shares`` of the measured slip jump, since a
-        fit without stiction has widened it by about half the jump.
+        its backlash narrowed by ``shares`` of the measured slip jump (a fit
+        without stiction has widened it by about half the jump) and, if asked,
+        ``perturbed`` times at random (slopes by about 30 %, corners by 0.3
+        units): the plateau levels alone, a sparse chain fit, have several
+        basins, and the level cost alone does not tell the right one.
     max_nfev : int
         Residual evaluations per least-squares run.
     weight : float
         Weight of the stick and slip conditions against the plateau levels.
     shares : sequence of float
         Backlash narrowings to start from (fractions of the slip jump).
+    perturbed, keep : int
+        Random starts per chain; distinct level fits (best first) carried on
+        to the stick and slip conditions.
     widen : int
         How many of the best consistent fits are pushed to the widest margin
         between the demand and the band (see :func:`_widen`).
+    rng : int
+        Seed of the random starts (the fit is reproducible).
 
     Returns
     -------
     list of StickSlipFit
-        Consistent fits first (the widened ones lead), then by cost; empty
-        when ``y`` is not a staircase of flat plateaus.
+        Fits that break no condition first, smallest band (in measurement
+        units) first -- the least friction that explains every slip; then the
+        others by cost. Empty when ``y`` is not a staircase of flat plateaus.
     """
     plat = plateaus(y, sigma)
     if not plat.is_staircase(sigma):
@@ -274,27 +292,99 @@ def fit_stick_slip_events(spec: ChainSpec, t_s: np.ndarray, v: np.ndarray, y: np
     lo = np.concatenate([spec.bounds[:, 0], [1e-4, -0.5]])
     hi = np.concatenate([spec.bounds[:, 1], [0.5, 0.5]])
     eps = 1e-9 * (hi - lo)
+    lo, hi = lo + eps, hi - eps
+    levels = []
+    for q0 in _starts(spec, res, chains, shares, perturbed, np.random.default_rng(rng)):
+        q = _least_squares(res, np.clip(q0, lo, hi), lo, hi, 0.0, max_nfev)
+        if q is not None:
+            levels.append((float(np.sum(res(q) ** 2)), q))
     fits = []
-    for chain in chains:
-        x0 = spec.signal(np.asarray(chain, dtype=float), t_s, v)
-        travel = float(np.ptp(x0)) or 1.0
-        a0 = res.calibration(x0)[0] or 1.0
-        jump = float(np.median(np.abs(np.diff(plat.levels)))) / abs(a0)
-        for share in shares:
-            c = _narrowed(chain, jump, share)
-            if c is None or not spec.feasible(c[None, :])[0]:
-                continue
-            q0 = np.clip(np.concatenate([c, [jump / travel, 0.0]]), lo + eps, hi - eps)
-            q = _solve(res, q0, lo + eps, hi - eps, weight, max_nfev)
-            if q is not None and spec.feasible(q[None, :-2])[0]:
-                fits.append((float(np.sum(res(q) ** 2)), res.violations(q), q))
+    for q in _distinct(levels, keep):
+        q = _solve(res, np.clip(res.restart_band(q), lo, hi), lo, hi, weight, max_nfev)
+        if q is not None and spec.feasible(q[None, :-2])[0]:
+            fits.append((float(np.sum(res(q) ** 2)), res.violations(q), q))
     fits.sort(key=lambda f: (f[1] > 0, f[0]))
     out = []
     for k, (_, broken, q) in enumerate(fits):
         if k < widen and broken == 0:
-            q = _widen(res, q, lo + eps, hi - eps, weight, max_nfev)
+            q = _widen(res, q, lo, hi, weight, max_nfev)
         out.append(_finish(spec, res, q, t_s, v, plat))
+    # several chains can reproduce every training slip, with different bands and initial
+    # states; the least friction that explains the slips is kept first
+    out.sort(key=lambda f: (f.violations > 0, f.band_measured if f.violations == 0 else 0.0,
+                            f.cost))
     return out
+
+
+def _distinct(levels: list[tuple[float, np.ndarray]], keep: int) -> list[np.ndarray]:
+    """The ``keep`` best level fits, one per basin (equal costs are one basin)."""
+    out: list[np.ndarray] = []
+    seen: list[float] = []
+    for cost, q in sorted(levels, key=lambda f: f[0]):
+        if any(abs(cost - c) <= 1e-4 * max(c, 1e-300) for c in seen):
+            continue
+        seen.append(cost)
+        out.append(q)
+        if len(out) >= keep:
+            break
+    return out
+
+
+def _starts(spec: ChainSpec, res: _EventResidual, chains: Sequence[np.ndarray],
+            shares: Sequence[float], perturbed: int, rng: np.random.Generator
+            ) -> list[np.ndarray]:
+    """Feasible ``(chain, band, offset)`` starts: narrowed and perturbed chains."""
+    out = []
+    for chain in chains:
+        chain = np.asarray(chain, dtype=float)
+        x0 = spec.signal(chain, res.t, res.v)
+        travel = float(np.ptp(x0)) or 1.0
+        jump = float(np.median(np.abs(np.diff(res.plat.levels)))) / abs(
+            res.calibration(x0)[0] or 1.0)
+        cands = [_narrowed(chain, jump, share) for share in shares]
+        for _ in range(perturbed):
+            c = chain * np.exp(0.3 * rng.standard_normal(chain.size))
+            c[4:8] = chain[4:8] + 0.3 * rng.standard_normal(4) * np.maximum(
+                np.abs(chain[4:8]), 1.0)
+            cands.append(c)
+        for c in cands:
+            if c is None:
+                continue
+            c = np.clip(c, spec.bounds[:, 0], spec.bounds[:, 1])
+            if spec.feasible(c[None, :])[0]:
+                out.append(np.concatenate([c, [jump / travel, 0.0]]))
+    return out
+
+
+def _least_squares(res: _EventResidual, q: np.ndarray, lo: np.ndarray, hi: np.ndarray,
+                   weight: float, max_nfev: int) -> np.ndarray | None:
+    """One bounded least-squares run at a condition weight (None when it fails)."""
+    saved, res.weight = res.weight, weight
+    try:
+        return least_squares(res, np.clip(q, lo, hi), bounds=(lo, hi), method='trf',
+                             max_nfev=max_nfev).x
+    except (ValueError, np.linalg.LinAlgError):
+        return None
+    finally:
+        res.weight = saved
+
+
+def _solve(res: _EventResidual, q0: np.ndarray, lo: np.ndarray, hi: np.ndarray,
+           weight: float, max_nfev: int) -> np.ndarray | None:
+    """The stick and slip conditions, weighted up until none is broken.
+
+    Starts from a fit of the plateau levels alone (with many conditions
+    broken at the start their hinges pull the chain every way and least
+    squares stalls). One broken condition is one slip a sample early or
+    late, which puts the simulated staircase out of step for good; the
+    levels can give a little for it.
+    """
+    q = q0
+    for factor in (1.0, 10.0, 100.0):
+        q = _least_squares(res, q, lo, hi, weight * factor, max_nfev)
+        if q is None or res.violations(q) == 0:
+            break
+    return q
 
 
 def _widen(res: _EventResidual, q: np.ndarray, lo: np.ndarray, hi: np.ndarray,
@@ -322,33 +412,6 @@ def _widen(res: _EventResidual, q: np.ndarray, lo: np.ndarray, hi: np.ndarray,
     return q
 
 
-def _solve(res: _EventResidual, q0: np.ndarray, lo: np.ndarray, hi: np.ndarray,
-           weight: float, max_nfev: int) -> np.ndarray | None:
-    """Levels first, then the conditions, weighted up until none is broken.
-
-    The plateau levels alone are a smooth chain fit; with many conditions
-    broken at the start their hinges pull the chain every way and least
-    squares stalls, so they come in once the levels fit. One broken
-    condition is one slip a sample early or late, which puts the simulated
-    staircase out of step for good; the levels can give a little for it.
-    """
-    q = q0
-    for factor in (0.0, 1.0, 10.0, 100.0):
-        res.weight = weight * factor
-        try:
-            q = least_squares(res, np.clip(q, lo, hi), bounds=(lo, hi), method='trf',
-                              max_nfev=max_nfev).x
-        except (ValueError, np.linalg.LinAlgError):
-            res.weight = weight
-            return None
-        if factor == 0.0:
-            q = np.clip(res.restart_band(q), lo, hi)
-        elif res.violations(q) == 0:
-            break
-    res.weight = weight
-    return q
-
-
 def _finish(spec: ChainSpec, res: _EventResidual, q: np.ndarray, t_s: np.ndarray,
             v: np.ndarray, plat: Plateaus) -> StickSlipFit:
     """Band and initial state in the middle of what the conditions allow."""
@@ -362,7 +425,9 @@ def _finish(spec: ChainSpec, res: _EventResidual, q: np.ndarray, t_s: np.ndarray
     stuck0 = 0.5 * (s_lo + s_hi) if s_lo <= s_hi else x[0] + q[-1] * travel
     return StickSlipFit(chain=np.array(chain), band_fraction=band / travel,
                         offset_fraction=(stuck0 - x[0]) / travel, cost=float(r @ r),
-                        violations=res.violations(q))
+                        violations=res.violations(q),
+                        slack=max(b_hi - b_lo, 0.0) / band if np.isfinite(b_hi) else 0.0,
+                        band_measured=abs(a) * band)
 
 
 def bands_from_demand(x: np.ndarray, y: np.ndarray, sigma: float

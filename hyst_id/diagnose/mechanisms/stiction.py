@@ -42,10 +42,14 @@ from typing import Any
 from numba import njit
 import numpy as np
 
+from hyst_id.diagnose.baseline import structured_starts
 from hyst_id.diagnose.mechanisms.base import Context, Mechanism, Quantity
 from hyst_id.diagnose.stick_events import fit_stick_slip_events
 
-__all__ = ['Stiction', 'MECHANISM', 'stick_slip']
+__all__ = ['Stiction', 'MECHANISM', 'STAIRCASE_SPLITS', 'stick_slip']
+
+#: Data-built chain starts for the event fit: loop width factors x share of B.
+STAIRCASE_SPLITS = tuple((f, s) for f in (0.7, 1.0, 1.4, 2.0) for s in (0.1, 0.5))
 
 
 @njit(cache=True)
@@ -97,10 +101,15 @@ class Stiction(Mechanism):
         if model.channel != 'position' or model.ids != (self.id,):
             return []
         n = data.n_train
+        t, v, y = data.t_s[:n], data.v[:n], data.y[:n]
+        spec = model.spec.with_bounds(model.bounds[:model.n_chain])
         chains = [np.asarray(p_prev[:model.n_chain])]
         chains += [np.asarray(c[:model.n_chain]) for c in chain_starts]
-        fits = fit_stick_slip_events(model.spec, data.t_s[:n], data.v[:n], data.y[:n],
-                                     data.noise_std, chains)
+        # the staircase hides the loop: data-built chains over a wider range of widths
+        chains += structured_starts(spec, t, v, y, np.zeros(0), splits=STAIRCASE_SPLITS)
+        fits = fit_stick_slip_events(spec, t, v, y, data.noise_std, chains)
+        # the four with the least friction that reproduce every slip (or, failing that, the
+        # four closest) compete on the training error of the simulated staircase
         out = []
         for f in fits[:4]:
             p = np.array(p_prev, dtype=float)
