@@ -110,10 +110,9 @@ def test_each_mechanism_is_named(mech):
     assert d.verdict == mech, d.report()
     f = d.findings[0]
     assert f.explanation and f.params
+    assert f.er_holdout_after_percent < 0.7 * f.er_holdout_before_percent
     if mech == 'stiction':
         check_stick_slip(d, band=0.04 * loop_travel(synthetic(None, seed=5)))
-        return
-    assert f.er_holdout_after_percent < 0.7 * f.er_holdout_before_percent
 
 
 def loop_travel(rec: Recording) -> float:
@@ -122,19 +121,15 @@ def loop_travel(rec: Recording) -> float:
 
 
 def check_stick_slip(d, band: float) -> None:
-    """Stiction's own criteria (docs/diagnosis.md, stick-slip).
+    """Stiction's own checks (docs/diagnosis.md, stick-slip).
 
     The staircase is lined up on the training part (every slip on its
     measured sample: training %e_r at the noise floor) and the slip band is
-    recovered. On held-out data a slip that falls when the demand barely
-    moves (near a reversal) is decided by less than the parameters are
-    known, lands a sample early or late and costs a whole jump there, so the
-    held-out error is only required to fall clearly.
+    recovered.
     """
     f = d.findings[0]
     assert f.er_train_after_percent < 1.5 * d.noise_floor_train_percent, d.report()
     assert f.params['slip_band'].value == pytest.approx(band, rel=0.03)
-    assert f.er_holdout_after_percent < 0.8 * f.er_holdout_before_percent, d.report()
 
 
 def test_json_document_has_the_issue_schema(delay_diagnosis, tmp_path):
