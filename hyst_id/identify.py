@@ -74,8 +74,9 @@ class IdentifySettings:
         Restarts stop once %e_r is within this factor of the noise floor.
     restart_patience : int
         Restarts also stop after this many in a row that lower the cost by
-        less than 1 % (the floor is out of reach of the model: real data with
-        unmodelled physics would otherwise always pay for every restart).
+        less than 1 % while %e_r is above 1.5 x the noise floor (the floor is
+        out of the model's reach: real data with unmodelled physics would
+        otherwise always pay for every restart).
     er_bound_percent : float or None
         Stop a GAASS run early once %e_r falls below this bound.
     """
@@ -207,7 +208,8 @@ def run_seed(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray, measurement:
     population are polished and the best kept; while %e_r stays above
     ``restart_factor`` times the noise floor, GAASS restarts with a seed
     derived from ``(seed, restart)``, up to ``restarts`` times, or until
-    ``restart_patience`` restarts in a row gain less than 1 %.
+    ``restart_patience`` restarts in a row gain less than 1 % while %e_r is
+    above 1.5 x the floor.
     ``on_generation(seed, restart, generation, er_percent)`` is called after
     every GAASS generation (it may raise to abandon the seed).
     """
@@ -253,7 +255,10 @@ def _run_seed(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray, measurement
                 best_x, best_fun = x, fun
         if best_fun <= good_enough or (target is not None and best_fun <= target):
             break
-        stalled = stalled + 1 if restart and best_fun > 0.99 * previous else 0
+        # far above the floor the model cannot reach it (unmodelled physics): stop once
+        # restarts stop gaining; near it a later restart often finds the exact basin
+        far = best_fun > (_STALL_FLOOR_FACTOR * floor_percent / 100.0) ** 2 * sum_sq
+        stalled = stalled + 1 if restart and far and best_fun > 0.99 * previous else 0
         if stalled >= settings.restart_patience:
             break
     k, b = spec.fit_calibration(best_x, t_s, command, measurement)
@@ -303,6 +308,10 @@ def _mp_context():
     if 'fork' in multiprocessing.get_all_start_methods() and threading.active_count() == 1:
         return multiprocessing.get_context('fork')
     return multiprocessing.get_context('spawn')
+
+
+#: Restarts may stop for lack of gain only above this multiple of the noise floor.
+_STALL_FLOOR_FACTOR = 1.5
 
 
 def _n_workers(settings: IdentifySettings) -> int:
