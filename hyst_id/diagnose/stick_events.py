@@ -289,8 +289,8 @@ def fit_stick_slip_events(spec: ChainSpec, t_s: np.ndarray, v: np.ndarray, y: np
     if not plat.is_staircase(sigma):
         return []
     res = _EventResidual(spec, t_s, v, plat, weight)
-    lo = np.concatenate([spec.bounds[:, 0], [1e-4, -0.5]])
-    hi = np.concatenate([spec.bounds[:, 1], [0.5, 0.5]])
+    lo = np.concatenate([spec.bounds[:, 0], [1e-4, -0.2]])   # as the stiction block
+    hi = np.concatenate([spec.bounds[:, 1], [0.2, 0.2]])
     eps = 1e-9 * (hi - lo)
     lo, hi = lo + eps, hi - eps
     levels = []
