@@ -132,3 +132,17 @@ def test_slips_of_a_few_noise_std_are_all_found():
     assert np.array_equal(p.edges[1:-1], slips)
     single = np.nonzero(np.abs(np.diff(y)) > 5.0 * NOISE)[0] + 1
     assert not np.array_equal(single, slips)     # one 5-sigma threshold misses some
+
+
+def test_slips_below_twice_the_noise_are_not_stiction():
+    from hyst_id.diagnose.mechanisms import MECHANISMS
+    from hyst_id.diagnose.sim_compare import _implausible
+
+    st = MECHANISMS['stiction']
+    coef, span = np.array([2.0, 0.0]), (0.0, 1.0)      # 2 measurement units per position unit
+    assert 'no visible slips' in st.implausible(np.array([0.002, 0.0]), coef, span, NOISE)
+    assert st.implausible(np.array([0.01, 0.0]), coef, span, NOISE) == ''
+    assert 'no visible slips' in _implausible('stiction', 'position', np.array([0.02, 0.8]),
+                                              NOISE)
+    assert _implausible('stiction', 'position', np.array([0.02, 0.3]), NOISE) == ''
+    assert _implausible('dead_time', 'position', np.array([0.0]), NOISE) == ''

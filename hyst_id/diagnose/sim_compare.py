@@ -239,6 +239,16 @@ def _stiction_from_events(obj: _SimObjective, demand: np.ndarray) -> np.ndarray 
     return np.array([static, dynamic / static])
 
 
+def _implausible(mech_id: str, channel: str, theta: np.ndarray, sigma: float) -> str:
+    """As :meth:`Mechanism.implausible`, for the simulator's settings (position slips)."""
+    if mech_id == 'stiction' and channel == 'position':
+        slip = float(theta[0]) * (1.0 - float(theta[1]))
+        if slip < 2.0 * sigma:
+            return (f'slip of {slip:.3g} is below twice the noise std ({sigma:.3g}): '
+                    'no visible slips')
+    return ''
+
+
 def _result(ids, theta, pred, y, n_train) -> FitResult:
     r = y - pred
     tr, ho = r[:n_train], r[n_train:]
@@ -323,6 +333,9 @@ def _diagnose_sim(recording, base, settings, say):
             fit.n_free = current.n_free + len(theta)
             comp = compare(current, fit, data, mid, settings.criteria)
             comp.evidence, comp.where = MECHANISMS[mid].evidence(loc)
+            reason = _implausible(mid, ch, theta, sigma)
+            if reason and comp.accepted:
+                comp.accepted, comp.status = False, f'rejected: {reason}'
             comps.append(comp)
             spaces[mid] = (obj, theta)
         winner, tied = choose(comps, data, settings.criteria)
