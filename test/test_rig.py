@@ -29,7 +29,7 @@ from hyst_id.excitation import eq24, eq25, EXCITATIONS, make_excitation, multisi
 from hyst_id.io.recording import count_reversals, validate_recording
 from hyst_id.rig import (Effects, load_rig_params, rig_params_from_dict, RigParams, RigSimulator,
                          save_rig_params, simulate_rig)
-from hyst_id.rig.params import as_rig_params
+from hyst_id.rig.params_file import as_rig_params
 from hyst_id.rig.physics import (flow_factor, isentropic_critical_ratio, LAMINAR_RATIO,
                                  manual_valve_area_m2, orifice_mass_flow_kg_s, PSI_PA)
 

@@ -23,8 +23,8 @@ one sample at a time for a real-time node. Parameters live in
 from __future__ import annotations
 
 from hyst_id.rig.effects import Effects
-from hyst_id.rig.params import (as_rig_params, load_rig_params, rig_params_from_dict,
-                                rig_params_to_dict, RigParams, save_rig_params)
+from hyst_id.rig.params import rig_params_from_dict, rig_params_to_dict, RigParams
+from hyst_id.rig.params_file import as_rig_params, load_rig_params, save_rig_params
 from hyst_id.rig.simulator import RigRun, RigSample, RigSimulator, simulate_rig, TRUTH_FIELDS
 
 __all__ = [

@@ -44,7 +44,8 @@ from hyst_id.models.sensors import first_order_coefficient, second_order_coeffic
 from hyst_id.rig.effects import (CHARACTERISTIC_KINDS, DELAY_CAPACITY, delay_lookup,
                                  delay_push, end_stop, rate_filter_step, stick_slip_step,
                                  valve_area_fraction)
-from hyst_id.rig.params import as_rig_params, RigParams
+from hyst_id.rig.params import RigParams
+from hyst_id.rig.params_file import as_rig_params
 from hyst_id.rig.physics import FLOW_MODELS, pneumatic_step, steady_state, vessel_mass
 
 __all__ = ['RigRun', 'RigSample', 'RigSimulator', 'simulate_rig', 'TRUTH_FIELDS', 'UNITS']
@@ -369,7 +370,7 @@ class RigSimulator:
     Parameters
     ----------
     params : RigParams, mapping, path or None
-        Rig parameters (see :func:`~hyst_id.rig.params.as_rig_params`);
+        Rig parameters (see :func:`~hyst_id.rig.params_file.as_rig_params`);
         ``None`` for the defaults.
     seed : int, optional
         Noise seed (a ``numpy.random.Generator`` is accepted too).

@@ -1,0 +1,135 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""Rig parameters in YAML files: ROS 2 params files or plain groups.
+
+:func:`load_rig_params` reads ``params/pipeline.yaml`` (a ROS params file,
+``node: ros__parameters: groups``) or a plain document of groups, dotted keys
+allowed; :func:`save_rig_params` writes the ROS layout back;
+:func:`as_rig_params` takes whatever a caller has (parameters, a mapping, a
+path or nothing).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, Mapping
+
+import yaml
+
+from hyst_id.errors import ConfigError
+from hyst_id.rig.params import (_merge, _unflatten, rig_params_from_dict, rig_params_to_dict,
+                                RigParams)
+
+__all__ = ['DEFAULT_NODE', 'as_rig_params', 'load_rig_params', 'save_rig_params']
+
+#: Node section written by :func:`save_rig_params`.
+DEFAULT_NODE = 'pipeline_sim'
+
+
+def load_rig_params(yaml_path: str | Path, *, node: str | None = None) -> RigParams:
+    """Read rig parameters from a YAML file (ROS params file or plain groups).
+
+    Parameters
+    ----------
+    yaml_path : str or pathlib.Path
+        The file.
+    node : str, optional
+        In a ROS params file, the node section to read (default every
+        section with ``ros__parameters``, ``/**`` first, later ones winning).
+
+    Raises
+    ------
+    ConfigError
+        Unreadable file, invalid YAML, unknown or invalid parameter.
+    """
+    path = Path(yaml_path)
+    try:
+        doc = yaml.safe_load(path.read_text(encoding='utf-8'))
+    except OSError as exc:
+        raise ConfigError(f'cannot read rig params {path}: {exc.strerror}') from None
+    except yaml.YAMLError as exc:
+        raise ConfigError(f'rig params {path} is not valid YAML: '
+                          f'{str(exc).splitlines()[0]}') from None
+    return _with_path(lambda: _from_document(doc, node), path)
+
+
+def _from_document(doc: Any, node: str | None = None) -> RigParams:
+    """Parameters from a parsed YAML document (ROS params layout or plain groups)."""
+    if doc is None:
+        doc = {}
+    if not isinstance(doc, Mapping):
+        raise ConfigError('rig params must be a mapping')
+    keys = [k for k in sorted(doc, key=lambda k: k != '/**')
+            if isinstance(doc[k], Mapping) and 'ros__parameters' in doc[k]]
+    if not keys:
+        return rig_params_from_dict(doc)
+    if node is not None:
+        keys = [k for k in keys if str(k).lstrip('/') == node.lstrip('/')]
+        if not keys:
+            raise ConfigError(f'no section {node}: ros__parameters')
+    merged: dict = {}
+    for section in (doc[k]['ros__parameters'] for k in keys):
+        if not isinstance(section, Mapping):
+            raise ConfigError('ros__parameters must be a mapping')
+        _merge(merged, _unflatten(section))
+    return rig_params_from_dict(merged, allow_unknown=True)
+
+
+def as_rig_params(params: Any = None) -> RigParams:
+    """Coerce ``params`` to :class:`RigParams`.
+
+    Parameters
+    ----------
+    params : RigParams, mapping, str, pathlib.Path or None
+        ``None``: the defaults; a mapping: a parsed params document (ROS
+        layout or plain groups, dotted keys allowed); a path: a YAML file.
+    """
+    if params is None:
+        return RigParams()
+    if isinstance(params, RigParams):
+        return params
+    if isinstance(params, (str, Path)):
+        return load_rig_params(params)
+    if isinstance(params, Mapping):
+        return _from_document(params)
+    raise ConfigError(f'rig params must be RigParams, a mapping or a path, got '
+                      f'{type(params).__name__}')
+
+
+def _with_path(build: Any, path: Path) -> RigParams:
+    try:
+        return build()
+    except ConfigError as exc:
+        raise ConfigError(f'{path}: {exc}') from None
+
+
+def save_rig_params(params: RigParams, yaml_path: str | Path, *,
+                    node: str = DEFAULT_NODE) -> Path:
+    """Write ``params`` as a ROS 2 params file (``node: ros__parameters: groups``).
+
+    Returns
+    -------
+    pathlib.Path
+        The file written; :func:`load_rig_params` reads it back unchanged.
+    """
+    path = Path(yaml_path)
+    body = {node: {'ros__parameters': rig_params_to_dict(params)}}
+    text = ('# hyst_id rig simulator parameters (see docs/rig.md for units and sources).\n'
+            + yaml.safe_dump(body, sort_keys=False, default_flow_style=False))
+    try:
+        path.write_text(text, encoding='utf-8')
+    except OSError as exc:
+        raise ConfigError(f'cannot write rig params {path}: {exc.strerror}') from None
+    return path
