@@ -143,12 +143,6 @@ class StickSlipFit:
         Level plus condition residual sum of squares (measurement units).
     violations : int
         Samples that break a stick or slip condition.
-    slack : float
-        Width of the band interval the conditions allow, relative to the
-        band (0 when they conflict): how far the tightest stick and slip
-        are apart, the room a held-out slip has to land on its sample.
-    band_measured : float
-        The band in measurement units (gauge invariant).
     """
 
     chain: np.ndarray
@@ -156,8 +150,6 @@ class StickSlipFit:
     offset_fraction: float
     cost: float
     violations: int
-    slack: float = 0.0
-    band_measured: float = 0.0
 
 
 class _EventResidual:
@@ -244,8 +236,7 @@ def fit_stick_slip_events(spec: ChainSpec, t_s: np.ndarray, v: np.ndarray, y: np
                           sigma: float, chains: Sequence[np.ndarray], *,
                           max_nfev: int = 3000, weight: float = 3.0,
                           shares: Sequence[float] = (0.5, 0.0),
-                          perturbed: int = 0, keep: int = 64, widen: int = 3,
-                          rng: int = 0) -> list[StickSlipFit]:
+                          keep: int = 64) -> list[StickSlipFit]:
     """Fit chain, band and initial state to the plateaus and slips of ``y``.
 
     Parameters
@@ -259,31 +250,23 @@ def fit_stick_slip_events(spec: ChainSpec, t_s: np.ndarray, v: np.ndarray, y: np
     chains : sequence of numpy.ndarray
         Chain starts (the baseline fit, data-built starts). Each is tried with
         its backlash narrowed by ``shares`` of the measured slip jump (a fit
-        without stiction has widened it by about half the jump) and, if asked,
-        ``perturbed`` times at random (slopes by about 30 %, corners by 0.3
-        units): the plateau levels alone, a sparse chain fit, have several
-        basins, and the level cost alone does not tell the right one.
+        without stiction has widened it by about half the jump).
     max_nfev : int
         Residual evaluations per least-squares run.
     weight : float
         Weight of the stick and slip conditions against the plateau levels.
     shares : sequence of float
         Backlash narrowings to start from (fractions of the slip jump).
-    perturbed, keep : int
-        Random starts per chain; distinct level fits (best first) carried on
-        to the stick and slip conditions.
-    widen : int
-        How many of the best consistent fits are pushed to the widest margin
-        between the demand and the band (see :func:`_widen`).
-    rng : int
-        Seed of the random starts (the fit is reproducible).
+    keep : int
+        Distinct plateau-level fits (best first) carried on to the stick and
+        slip conditions: the levels alone, a sparse chain fit, have several
+        basins, and their cost does not tell the right one.
 
     Returns
     -------
     list of StickSlipFit
-        Fits that break no condition first, smallest band (in measurement
-        units) first -- the least friction that explains every slip; then the
-        others by cost. Empty when ``y`` is not a staircase of flat plateaus.
+        Fits that break no condition first, then by cost. Empty when ``y`` is
+        not a staircase of flat plateaus.
     """
     plat = plateaus(y, sigma)
     if not plat.is_staircase(sigma):
@@ -294,7 +277,7 @@ def fit_stick_slip_events(spec: ChainSpec, t_s: np.ndarray, v: np.ndarray, y: np
     eps = 1e-9 * (hi - lo)
     lo, hi = lo + eps, hi - eps
     levels = []
-    for q0 in _starts(spec, res, chains, shares, perturbed, np.random.default_rng(rng)):
+    for q0 in _starts(spec, res, chains, shares):
         q = _least_squares(res, np.clip(q0, lo, hi), lo, hi, 0.0, max_nfev)
         if q is not None:
             levels.append((float(np.sum(res(q) ** 2)), q))
@@ -302,18 +285,9 @@ def fit_stick_slip_events(spec: ChainSpec, t_s: np.ndarray, v: np.ndarray, y: np
     for q in _distinct(levels, keep):
         q = _solve(res, np.clip(res.restart_band(q), lo, hi), lo, hi, weight, max_nfev)
         if q is not None and spec.feasible(q[None, :-2])[0]:
-            fits.append((float(np.sum(res(q) ** 2)), res.violations(q), q))
-    fits.sort(key=lambda f: (f[1] > 0, f[0]))
-    out = []
-    for k, (_, broken, q) in enumerate(fits):
-        if k < widen and broken == 0:
-            q = _widen(res, q, lo, hi, weight, max_nfev)
-        out.append(_finish(spec, res, q, t_s, v, plat))
-    # several chains can reproduce every training slip, with different bands and initial
-    # states; the least friction that explains the slips is kept first
-    out.sort(key=lambda f: (f.violations > 0, f.band_measured if f.violations == 0 else 0.0,
-                            f.cost))
-    return out
+            fits.append(_finish(spec, res, q, t_s, v, plat))
+    fits.sort(key=lambda f: (f.violations > 0, f.cost))
+    return fits
 
 
 def _distinct(levels: list[tuple[float, np.ndarray]], keep: int) -> list[np.ndarray]:
@@ -331,9 +305,8 @@ def _distinct(levels: list[tuple[float, np.ndarray]], keep: int) -> list[np.ndar
 
 
 def _starts(spec: ChainSpec, res: _EventResidual, chains: Sequence[np.ndarray],
-            shares: Sequence[float], perturbed: int, rng: np.random.Generator
-            ) -> list[np.ndarray]:
-    """Feasible ``(chain, band, offset)`` starts: narrowed and perturbed chains."""
+            shares: Sequence[float]) -> list[np.ndarray]:
+    """Feasible ``(chain, band, offset)`` starts: the chains with narrowed backlashes."""
     out = []
     for chain in chains:
         chain = np.asarray(chain, dtype=float)
@@ -341,13 +314,7 @@ def _starts(spec: ChainSpec, res: _EventResidual, chains: Sequence[np.ndarray],
         travel = float(np.ptp(x0)) or 1.0
         jump = float(np.median(np.abs(np.diff(res.plat.levels)))) / abs(
             res.calibration(x0)[0] or 1.0)
-        cands = [_narrowed(chain, jump, share) for share in shares]
-        for _ in range(perturbed):
-            c = chain * np.exp(0.3 * rng.standard_normal(chain.size))
-            c[4:8] = chain[4:8] + 0.3 * rng.standard_normal(4) * np.maximum(
-                np.abs(chain[4:8]), 1.0)
-            cands.append(c)
-        for c in cands:
+        for c in (_narrowed(chain, jump, share) for share in shares):
             if c is None:
                 continue
             c = np.clip(c, spec.bounds[:, 0], spec.bounds[:, 1])
@@ -387,31 +354,6 @@ def _solve(res: _EventResidual, q0: np.ndarray, lo: np.ndarray, hi: np.ndarray,
     return q
 
 
-def _widen(res: _EventResidual, q: np.ndarray, lo: np.ndarray, hi: np.ndarray,
-           weight: float, max_nfev: int) -> np.ndarray:
-    """Push the demand away from the band at every stick and slip (largest margin kept).
-
-    Several chains fit the training slips; the one whose conditions hold
-    with the widest margin is the most central of them, and the least likely
-    to put a held-out slip a sample early or late.
-    """
-    res.weight = 10.0 * weight
-    try:
-        for margin in (0.003, 0.01, 0.03, 0.1):
-            res.margin = margin
-            try:
-                trial = least_squares(res, np.clip(q, lo, hi), bounds=(lo, hi), method='trf',
-                                      max_nfev=max_nfev).x
-            except (ValueError, np.linalg.LinAlgError):
-                break
-            if np.any(res(trial)[res.plat.levels.size:]):
-                break
-            q = trial
-    finally:
-        res.margin, res.weight = 1e-3, weight
-    return q
-
-
 def _finish(spec: ChainSpec, res: _EventResidual, q: np.ndarray, t_s: np.ndarray,
             v: np.ndarray, plat: Plateaus) -> StickSlipFit:
     """Band and initial state in the middle of what the conditions allow."""
@@ -425,9 +367,7 @@ def _finish(spec: ChainSpec, res: _EventResidual, q: np.ndarray, t_s: np.ndarray
     stuck0 = 0.5 * (s_lo + s_hi) if s_lo <= s_hi else x[0] + q[-1] * travel
     return StickSlipFit(chain=np.array(chain), band_fraction=band / travel,
                         offset_fraction=(stuck0 - x[0]) / travel, cost=float(r @ r),
-                        violations=res.violations(q),
-                        slack=max(b_hi - b_lo, 0.0) / band if np.isfinite(b_hi) else 0.0,
-                        band_measured=abs(a) * band)
+                        violations=res.violations(q))
 
 
 def bands_from_demand(x: np.ndarray, y: np.ndarray, sigma: float

@@ -108,8 +108,8 @@ class Stiction(Mechanism):
         # the staircase hides the loop: data-built chains over a wider range of widths
         chains += structured_starts(spec, t, v, y, np.zeros(0), splits=STAIRCASE_SPLITS)
         fits = fit_stick_slip_events(spec, t, v, y, data.noise_std, chains)
-        # the four with the least friction that reproduce every slip (or, failing that, the
-        # four closest) compete on the training error of the simulated staircase
+        # several chains can reproduce every training slip; the four best compete on the
+        # training error of the simulated staircase
         out = []
         for f in fits[:4]:
             p = np.array(p_prev, dtype=float)
