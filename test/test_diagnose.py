@@ -139,13 +139,16 @@ def check_stick_slip(d, band: float) -> None:
 
 @pytest.mark.slow
 def test_stick_slip_is_lined_up_on_held_out_data_mostly():
-    """Six noise seeds: every one named, most at the noise floor on held-out data too."""
+    """Twelve noise seeds: every one named, at least half at the floor on held-out data.
+
+    9 of 12 were at the time of writing (docs/diagnosis.md).
+    """
     ratios = []
-    for seed in range(5, 11):
+    for seed in range(5, 17):
         d = diagnose(synthetic('stiction', seed=seed), settings=FAST)
         assert d.verdict == 'stiction', d.report()
         ratios.append(d.final.er_holdout_percent / d.noise_floor_percent)
-    assert sum(r < 1.5 for r in ratios) >= 3, np.round(ratios, 2)
+    assert sum(r < 1.5 for r in ratios) >= 6, np.round(ratios, 2)
 
 
 def test_json_document_has_the_issue_schema(delay_diagnosis, tmp_path):
