@@ -48,7 +48,7 @@ import yaml
 
 from hyst_id.errors import ConfigError
 
-__all__ = ['COMPENSATOR_NAMES', 'compensator_values', 'read_compensator_params',
+__all__ = ['COMPENSATOR_NAMES', 'compensator_values', 'read_compensator_params', 'read_yaml',
            'write_compensator_params']
 
 #: Model parameters the compensator takes (hysteresis 8, backlash 3), in order.
@@ -161,6 +161,28 @@ def _yaml_float(value: float) -> str:
     return repr(float(value))
 
 
+def read_yaml(path: str | Path, what: str = '') -> Any:
+    """Parsed YAML document of a file, or a one-line ConfigError.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The file.
+    what : str
+        What the file holds, for the message (``'rig params'``).
+    """
+    path = Path(path)
+    name = f'{what} {path}' if what else str(path)
+    try:
+        return yaml.safe_load(path.read_text(encoding='utf-8'))
+    except FileNotFoundError:
+        raise ConfigError(f'cannot read {name}: no such file') from None
+    except OSError as exc:
+        raise ConfigError(f'cannot read {name}: {exc.strerror or exc}') from None
+    except yaml.YAMLError as exc:
+        raise ConfigError(f'{name} is not valid YAML: {" ".join(str(exc).split())}') from None
+
+
 def read_compensator_params(path: str | Path, node_name: str | None = None) -> dict[str, Any]:
     """Read ``{channel, m_l ... c_br, output_sign, er_percent}`` from a params file.
 
@@ -179,14 +201,7 @@ def read_compensator_params(path: str | Path, node_name: str | None = None) -> d
         parameters.
     """
     path = Path(path)
-    try:
-        doc = yaml.safe_load(path.read_text(encoding='utf-8'))
-    except FileNotFoundError:
-        raise ConfigError(f'no such file: {path}') from None
-    except OSError as exc:
-        raise ConfigError(f'cannot read {path}: {exc.strerror or exc}') from None
-    except yaml.YAMLError as exc:
-        raise ConfigError(f'{path} is not valid YAML: {str(exc).splitlines()[0]}') from None
+    doc = read_yaml(path)
     if not isinstance(doc, dict):
         raise ConfigError(f'{path}: expected "<node>: ros__parameters:" sections')
     sections = {str(k).strip('/') or '/': v for k, v in doc.items()

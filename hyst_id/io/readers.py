@@ -33,10 +33,10 @@ import re
 from typing import Any
 
 import numpy as np
-import yaml
 
 from hyst_id.errors import ConfigError, MissingTopicError, RecordingError
 from hyst_id.io.bag import open_bag
+from hyst_id.io.params_file import read_yaml
 from hyst_id.io.recording import CHANNELS, Recording, validate_recording
 
 __all__ = [
@@ -192,13 +192,7 @@ def load_topic_config(yaml_path: str | Path, channel: str, *,
         invalid values.
     """
     yaml_path = Path(yaml_path)
-    try:
-        doc = yaml.safe_load(yaml_path.read_text(encoding='utf-8'))
-    except OSError as exc:
-        raise ConfigError(f'cannot read {yaml_path}: {exc.strerror}') from None
-    except yaml.YAMLError as exc:
-        raise ConfigError(f'{yaml_path} is not valid YAML: '
-                          f'{" ".join(str(exc).split())}') from None
+    doc = read_yaml(yaml_path)
     doc = {} if doc is None else doc
     if not isinstance(doc, dict):
         raise ConfigError(f'{yaml_path}: expected a mapping at the top level')

@@ -29,6 +29,7 @@ from typing import Any, Mapping
 import yaml
 
 from hyst_id.errors import ConfigError
+from hyst_id.io.params_file import read_yaml
 from hyst_id.rig.params import (_merge, _unflatten, rig_params_from_dict, rig_params_to_dict,
                                 RigParams)
 
@@ -55,13 +56,7 @@ def load_rig_params(yaml_path: str | Path, *, node: str | None = None) -> RigPar
         Unreadable file, invalid YAML, unknown or invalid parameter.
     """
     path = Path(yaml_path)
-    try:
-        doc = yaml.safe_load(path.read_text(encoding='utf-8'))
-    except OSError as exc:
-        raise ConfigError(f'cannot read rig params {path}: {exc.strerror}') from None
-    except yaml.YAMLError as exc:
-        raise ConfigError(f'rig params {path} is not valid YAML: '
-                          f'{str(exc).splitlines()[0]}') from None
+    doc = read_yaml(path, 'rig params')
     return _with_path(lambda: _from_document(doc, node), path)
 
 
