@@ -23,8 +23,8 @@ import pytest
 
 from hyst_id.chains import chain_spec
 from hyst_id.diagnose.mechanisms.stiction import stick_slip
-from hyst_id.diagnose.stick_events import (bands_from_demand, fit_stick_slip_events, plateaus,
-                                           stick_intervals)
+from hyst_id.diagnose.plateaus import plateaus
+from hyst_id.diagnose.stick_events import bands_from_demand, fit_stick_slip_events, stick_intervals
 from hyst_id.excitation import multisine
 
 __all__: list[str] = []

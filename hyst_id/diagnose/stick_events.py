@@ -60,8 +60,7 @@ from scipy.optimize import least_squares
 from hyst_id.chains import ChainSpec
 from hyst_id.diagnose.plateaus import Plateaus, plateaus
 
-__all__ = ['Plateaus', 'StickSlipFit', 'bands_from_demand', 'fit_stick_slip_events', 'plateaus',
-           'stick_intervals']
+__all__ = ['StickSlipFit', 'bands_from_demand', 'fit_stick_slip_events', 'stick_intervals']
 
 
 @njit(cache=True)
@@ -175,6 +174,11 @@ class _EventResidual:
         coef, *_ = np.linalg.lstsq(design, self.plat.levels[1:] * w, rcond=None)
         return coef
 
+    @property
+    def median_jump(self) -> float:
+        """Median step between plateau levels, measurement units."""
+        return float(np.median(np.abs(np.diff(self.plat.levels))))
+
     def restart_band(self, q: np.ndarray) -> np.ndarray:
         """``q`` with band and initial offset re-estimated for its chain.
 
@@ -190,7 +194,7 @@ class _EventResidual:
         if a == 0:
             return q
         out = np.array(q, dtype=float)
-        out[-2] = float(np.median(np.abs(np.diff(self.plat.levels)))) / abs(a) / travel
+        out[-2] = self.median_jump / abs(a) / travel
         out[-1] = ((self.plat.levels[0] - b) / a - x[0]) / travel
         return out
 
@@ -312,8 +316,7 @@ def _starts(spec: ChainSpec, res: _EventResidual, chains: Sequence[np.ndarray],
         chain = np.asarray(chain, dtype=float)
         x0 = spec.signal(chain, res.t, res.v)
         travel = float(np.ptp(x0)) or 1.0
-        jump = float(np.median(np.abs(np.diff(res.plat.levels)))) / abs(
-            res.calibration(x0)[0] or 1.0)
+        jump = res.median_jump / abs(res.calibration(x0)[0] or 1.0)
         for c in (_narrowed(chain, jump, share) for share in shares):
             if c is None:
                 continue
