@@ -29,6 +29,9 @@ import os
 import sys
 
 from hyst_id.errors import HystIdError
+from hyst_id.pins import pin_numerics
+
+pin_numerics()   # before any subcommand imports NumPy (docs/reproducibility.md)
 
 __all__ = ['main', 'build_parser', 'COMMANDS']
 

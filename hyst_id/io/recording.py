@@ -23,6 +23,7 @@ return passes through :func:`validate_recording` once, here.
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+import os
 
 import numpy as np
 
@@ -31,7 +32,9 @@ from hyst_id.errors import NoExcitationError, RecordingError
 __all__ = [
     'CHANNELS',
     'Recording',
+    'ROUNDOFF_PROBE_ENV',
     'count_reversals',
+    'roundoff_probe',
     'validate_recording',
 ]
 
@@ -243,4 +246,46 @@ def validate_recording(rec: Recording, *, min_samples: int = MIN_SAMPLES,
             f'{min_reversals} reversals to excite the hysteresis loop')
     if np.ptp(arrays['measurement']) <= 0.0:
         raise RecordingError('measurement is constant: the sensor shows no response')
-    return replace(rec, **arrays)
+    return replace(rec, **roundoff_probe(arrays))
+
+
+#: Environment variable of the round-off probe (``<seed>`` or ``<seed>:<relative size>``).
+ROUNDOFF_PROBE_ENV = 'HYST_ID_ROUNDOFF_PROBE'
+
+
+def roundoff_probe(arrays: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """Perturb a validated recording at round-off level when the probe is switched on.
+
+    Another CPU make sums in another order and differs in the last bits of
+    every result; this imitates it. With ``HYST_ID_ROUNDOFF_PROBE=<seed>``
+    (optionally ``<seed>:<size>``, default size ``1e-12``) every measurement
+    sample is multiplied by ``1 + size * z`` (``z`` standard normal, drawn
+    from ``seed``) and the whole command by one such factor (held commands
+    stay equal, their order is kept). Unset or empty: the arrays are returned
+    unchanged. ``bench/roundoff_verdicts.py`` runs the suite under it.
+
+    Parameters
+    ----------
+    arrays : dict of numpy.ndarray
+        ``t_s``, ``command`` and ``measurement`` of a validated recording.
+
+    Returns
+    -------
+    dict of numpy.ndarray
+        The same arrays, perturbed when the probe is on.
+    """
+    setting = os.environ.get(ROUNDOFF_PROBE_ENV, '').strip()
+    if not setting:
+        return arrays
+    seed, _, size = setting.partition(':')
+    try:
+        rng = np.random.default_rng(int(seed))
+        eps = float(size) if size else 1e-12
+    except ValueError:
+        raise RecordingError(f'{ROUNDOFF_PROBE_ENV}={setting!r}: expected <seed>[:<size>]') \
+            from None
+    out = dict(arrays)
+    y = arrays['measurement']
+    out['measurement'] = y * (1.0 + eps * rng.standard_normal(y.shape[0]))
+    out['command'] = arrays['command'] * (1.0 + eps * float(rng.standard_normal()))
+    return out
