@@ -14,7 +14,7 @@
 
 """Compensator latency: compute time per sample, and desired -> command through DDS.
 
-1. Compute: :meth:`hyst_id.compensate.Compensator.step` with the paper's
+1. Compute: :meth:`hyst_id.compensation.Compensator.step` with the paper's
    hysteresis, timed sample by sample (target: median < 20 us).
 2. Loopback: the compensator node runs as its own process (own ROS domain,
    localhost discovery); this script publishes Eq. 25 desired values at
@@ -41,14 +41,13 @@ import time
 
 import numpy as np
 
-
 PAPER = {'m_l': 1.01, 'm_r': 1.05, 'm_t': 0.10, 'm_b': 0.15, 'c_l': -0.25, 'c_r': 0.50,
          'c_t': 14.0, 'c_b': 7.0, 'm_bl': 1.0, 'c_bl': -0.25, 'c_br': 0.25}
 
 
 def compute_times(n: int = 100_000) -> np.ndarray:
     """Per-sample compute time (ns) of Compensator.step on Eq. 25 desired values."""
-    from hyst_id.compensate import CommandLimits, Compensator, InverseModel
+    from hyst_id.compensation import CommandLimits, Compensator, InverseModel
     comp = Compensator(InverseModel.from_mapping(PAPER), CommandLimits(4.0, 20.0), v0=9.0)
     desired = 9.0 + np.sin(2 * np.pi * np.arange(n) * 0.01 / 12.0)
     for d in desired[:2000]:                       # JIT / cache warm-up
@@ -71,7 +70,7 @@ def loopback(rate_hz: float, seconds: float, context, ref) -> dict:
     from rclpy.node import Node
     from std_msgs.msg import Float64
 
-    from hyst_id.nodes import COMMAND_QOS
+    from hyst_id.nodes.support import COMMAND_QOS
 
     node = Node(f'latency_{int(rate_hz)}', context=context)
     pub = node.create_publisher(Float64, '/hyst_id/desired', COMMAND_QOS)
@@ -147,7 +146,8 @@ def main(argv: list[str] | None = None) -> int:
     os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
     overrides = [a for k, v in PAPER.items() for a in ('-p', f'{k}:={v!r}')]
     import rclpy
-    from hyst_id.compensate import CommandLimits, Compensator, InverseModel
+
+    from hyst_id.compensation import CommandLimits, Compensator, InverseModel
     context = rclpy.Context()
     rclpy.init(context=context)
     rows = []

@@ -28,13 +28,13 @@ limits) and invalid ones (a loop that is not proper, an incomplete set,
 * **updates**: every valid update applied, every invalid one rejected with
   a reason, and each applied one announced once on ``/compensator/active_set``
   (generation and first sample);
-* **atomicity**: a shadow :class:`hyst_id.compensate.Compensator`, run
+* **atomicity**: a shadow :class:`hyst_id.compensation.Compensator`, run
   offline over the sent desired values and switched to each announced set
   at its first sample, reproduces every received command exactly: each
   command came from exactly one complete parameter set, and the switches
   happened where the node said.
 
-``run_load`` is also what ``test/test_reliability_ros.py`` runs (5 s).
+``run_load`` is also what ``test/nodes/test_reliability_ros.py`` runs (5 s).
 
 Usage: ``python bench/compensator_load.py [--seconds 60] [--rate 1000] [--domain 92]``
 """
@@ -91,15 +91,15 @@ def _start_compensator(log_path: str) -> subprocess.Popen:
 def run_load(rate_hz: float = 1000.0, seconds: float = 60.0, update_every_s: float = 1.0,
              log_path: str = 'compensator_load.log') -> dict[str, Any]:
     """Drive a compensator process at ``rate_hz``; return the counts (see module docstring)."""
-    import rclpy
     from rcl_interfaces.srv import SetParametersAtomically
+    import rclpy
     from rclpy.executors import SingleThreadedExecutor
     from rclpy.node import Node
     from rclpy.parameter import Parameter
     from std_msgs.msg import Float64, String
 
-    from hyst_id.nodes import COMMAND_QOS, try_publish
     from hyst_id.nodes.compensator import ACTIVE_SET_QOS
+    from hyst_id.nodes.support import COMMAND_QOS, try_publish
 
     proc = _start_compensator(log_path)
     context = rclpy.Context()
@@ -181,7 +181,7 @@ def run_load(rate_hz: float = 1000.0, seconds: float = 60.0, update_every_s: flo
 def _analyse(desired: np.ndarray, sent_ns: np.ndarray, recv: list, sets: list, requests: list,
              rate_hz: float, seconds: float, publish_s: float, retries: int,
              code: int) -> dict[str, Any]:
-    from hyst_id.compensate import CommandLimits, Compensator, InverseModel
+    from hyst_id.compensation import CommandLimits, Compensator, InverseModel
 
     n = desired.size
     out = np.array([v for _, v in recv])

@@ -41,10 +41,10 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from hyst_id.diagnose import diagnose, DiagnoseSettings  # noqa: E402
-from hyst_id.diagnose.mechanisms import MECHANISM_IDS  # noqa: E402
-from hyst_id.excitation import multisine  # noqa: E402
+from hyst_id.diagnosis import diagnose, DiagnoseSettings  # noqa: E402
+from hyst_id.diagnosis.mechanisms import MECHANISM_IDS  # noqa: E402
 from hyst_id.rig import RigParams, simulate_rig  # noqa: E402
+from hyst_id.signals.excitation import multisine  # noqa: E402
 
 DT_S, DURATION_S = 0.05, 120.0
 PRESSURE = {'pressure_sensor.noise_std_pa': 1000.0}

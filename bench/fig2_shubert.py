@@ -33,9 +33,9 @@ import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir))
 
-from hyst_id import benchmarks as bm  # noqa: E402
-from hyst_id.benchmarks import shubert_2d, simple_ga  # noqa: E402
-from hyst_id.gaass import GaassResult, minimize  # noqa: E402
+from hyst_id.solvers import simple_ga as bm  # noqa: E402
+from hyst_id.solvers.gaass import GaassResult, minimize  # noqa: E402
+from hyst_id.solvers.simple_ga import shubert_2d, simple_ga  # noqa: E402
 
 __all__ = ['run', 'main']
 

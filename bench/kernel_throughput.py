@@ -16,7 +16,7 @@
 
 For each channel, a population of feasible candidates (the test chain's
 parameters, jittered) is scored on the paper's Eq. 24 run (2000 samples)
-by :func:`hyst_id.chains.population_cost` through ``ChainSpec.cost_function``
+by :func:`hyst_id.identification.chains.population_cost` through ``ChainSpec.cost_function``
 (affine calibration profiled: one simulation pass and two passes for the
 fit). One chain sample = one candidate advanced by one time step. The
 kernel is single-threaded numba; the best of several repeats is reported.
@@ -36,7 +36,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir))
 
-from hyst_id.chains import chain_spec  # noqa: E402
+from hyst_id.identification.chains import chain_spec  # noqa: E402
 
 __all__ = ['throughput', 'main']
 

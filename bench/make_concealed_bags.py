@@ -18,7 +18,7 @@ Each bag is a rosbag2 MCAP directory written with
 :func:`hyst_id.io.bag.write_recording_bag` from a run of the pipeline rig
 simulator (:func:`hyst_id.rig.simulate_rig`) with at most one effect
 switched on. The bag names (``case_a`` ...) do not say which: the answer
-key is :data:`CASES` below, read by ``test/test_concealed_bags.py``, and
+key is :data:`CASES` below, read by ``test/diagnosis/test_concealed_bags.py``, and
 ``bags/README.md`` lists only the channel of each bag.
 
 Run from the repository root::
@@ -37,9 +37,9 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from hyst_id.excitation import eq25, multisine  # noqa: E402
 from hyst_id.io.bag import write_recording_bag  # noqa: E402
 from hyst_id.rig import RigParams, simulate_rig  # noqa: E402
+from hyst_id.signals.excitation import eq25, multisine  # noqa: E402
 
 #: Sampling and length of every bag.
 DT_S = 0.05

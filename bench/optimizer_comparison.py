@@ -31,7 +31,7 @@ seed of that channel (it stops once it reaches the noise floor), or
 
 * ``GAASS``: the paper's settings, generations raised to spend the budget.
 * ``GAASS (paper)``: the paper's 500 generations, for reference.
-* ``GAASS + refine``: :func:`hyst_id.identify.run_seed`, restarts allowed
+* ``GAASS + refine``: :func:`hyst_id.identification.run_seed`, restarts allowed
   within the budget.
 * ``DE``: :func:`scipy.optimize.differential_evolution`, default strategy
   and population (15 per parameter), vectorised, no polish, ``tol = 0`` so
@@ -61,10 +61,10 @@ from threadpoolctl import threadpool_limits
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir))
 
-from hyst_id.chains import chain_spec, ChainSpec, er_percent  # noqa: E402
-from hyst_id.identify import IdentifySettings, run_seed  # noqa: E402
+from hyst_id.identification import IdentifySettings, run_seed  # noqa: E402
+from hyst_id.identification.chains import chain_spec, ChainSpec, er_percent  # noqa: E402
 from hyst_id.io.recording import Recording  # noqa: E402
-from hyst_id.noise import noise_floor_percent  # noqa: E402
+from hyst_id.signals.noise import noise_floor_percent  # noqa: E402
 
 __all__ = ['simulate', 'run_method', 'main']
 
@@ -90,7 +90,7 @@ def simulate(channel: str, *, noise_percent: float = 0.5, seed: int = 1) -> Reco
 
 def _spec(channel: str, domains: str, rec: Recording) -> ChainSpec:
     if domains == 'auto':
-        from hyst_id.domains import domains_from_data
+        from hyst_id.identification.domains import domains_from_data
         return domains_from_data(rec)
     return chain_spec(channel)
 

@@ -14,7 +14,7 @@
 
 """Stick-slip over noise seeds: verdict, slip band and held-out %e_r / noise floor per seed.
 
-The synthetic stiction record of ``test/test_diagnose.py`` (the paper's chain,
+The synthetic stiction record of ``test/diagnosis/test_diagnose.py`` (the paper's chain,
 slip band 4 % of the travel, 0.005 noise) with seeds 5-16, diagnosed with the
 test's settings. The figures in docs/diagnosis.md ("9 of 12 noise seeds end
 at the noise floor on held-out data") come from this script.
@@ -32,11 +32,11 @@ import sys
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
-sys.path.insert(0, str(ROOT / 'test'))
+sys.path.insert(0, str(ROOT / 'test' / 'diagnosis'))
 
 from test_diagnose import FAST, synthetic  # noqa: E402,I100
 
-from hyst_id.diagnose import diagnose  # noqa: E402
+from hyst_id.diagnosis import diagnose  # noqa: E402
 
 
 def main(argv=None) -> int:

@@ -12,6 +12,58 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
-"""hyst_id: identify actuator hysteresis with GAASS and cancel it in-line."""
+"""hyst_id: identify actuator hysteresis, cancel it in-line, find what the model left out.
 
-__version__ = '0.1.0'
+The public API, as rosbags and pysindy expose theirs (details in ``docs/api.md``)::
+
+    from hyst_id import read_recording, identify, diagnose, Compensator, InverseModel
+
+    rec = read_recording('run.mcap', 'position')        # or a CSV
+    ident = identify(rec)                                # -> Identification
+    diag = diagnose(rec)                                 # -> Diagnosis
+    comp = Compensator(InverseModel.from_mapping(dict(ident.params,
+                                                      output_sign=ident.output_sign)))
+
+The stages live in subpackages (``docs/architecture.md``): :mod:`hyst_id.signals`,
+:mod:`hyst_id.io`, :mod:`hyst_id.models`, :mod:`hyst_id.solvers`,
+:mod:`hyst_id.identification`, :mod:`hyst_id.compensation`, :mod:`hyst_id.rig`,
+:mod:`hyst_id.diagnosis`, :mod:`hyst_id.experiment`, :mod:`hyst_id.live`, and
+the ROS 2 nodes in :mod:`hyst_id.nodes`. Names below are imported on first use,
+so ``import hyst_id`` stays light (a node does not pay for the optimisers).
+"""
+
+from hyst_id import _deprecated
+
+__version__ = '0.2.0'
+
+#: Public name -> module that defines it.
+_API = {
+    'read_recording': 'hyst_id.io.readers',
+    'Recording': 'hyst_id.io.recording',
+    'validate_recording': 'hyst_id.io.recording',
+    'identify': 'hyst_id.identification',
+    'Identification': 'hyst_id.identification',
+    'IdentifySettings': 'hyst_id.identification',
+    'diagnose': 'hyst_id.diagnosis',
+    'Diagnosis': 'hyst_id.diagnosis',
+    'DiagnoseSettings': 'hyst_id.diagnosis',
+    'Compensator': 'hyst_id.compensation',
+    'CommandLimits': 'hyst_id.compensation',
+    'InverseModel': 'hyst_id.compensation',
+    'HystIdError': 'hyst_id.errors',
+}
+
+__all__ = sorted(_API) + ['__version__']
+
+_deprecated.install()
+
+
+def __getattr__(name: str):
+    """Import a public name on first use (PEP 562)."""
+    module = _API.get(name)
+    if module is None:
+        raise AttributeError(f'module {__name__!r} has no attribute {name!r}')
+    import importlib
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value

@@ -23,7 +23,7 @@ import time
 import numpy as np
 import pytest
 
-from hyst_id.chains import chain_spec
+from hyst_id.identification.chains import chain_spec
 from hyst_id.io.recording import Recording
 
 #: The paper's induced hysteresis plus a unit-slope backlash of 0.3 mA width,

@@ -18,12 +18,9 @@ from __future__ import annotations
 
 import argparse
 
-import yaml
-
-from hyst_id.chains import CHAIN_NAMES, ChainSpec
-from hyst_id.domains import domains_from_data, preset_spec, PRESETS
 from hyst_id.errors import ConfigError
-from hyst_id.identify import IdentifySettings
+from hyst_id.identification import config, IdentifySettings
+from hyst_id.identification.chains import CHAIN_NAMES, ChainSpec
 from hyst_id.io.recording import Recording
 
 __all__ = ['add_recording_arguments', 'add_settings_arguments', 'load_recording',
@@ -70,7 +67,8 @@ def add_settings_arguments(parser: argparse.ArgumentParser) -> None:
 
 def load_recording(args: argparse.Namespace) -> Recording:
     """Read and validate the recording named on the command line."""
-    from hyst_id.io.readers import load_topic_config, read_recording
+    from hyst_id.io.readers import read_recording
+    from hyst_id.io.topics import load_topic_config
 
     topics = load_topic_config(args.params, args.channel) if args.params else None
     columns = None
@@ -85,36 +83,12 @@ def load_recording(args: argparse.Namespace) -> Recording:
 
 def make_settings(args: argparse.Namespace) -> IdentifySettings:
     """GAASS settings from the command line."""
-    if args.seeds < 1 or args.pop_size < 2 or args.generations < 1 or args.restarts < 0:
-        raise ConfigError('need --seeds >= 1, --pop-size >= 2, --generations >= 1 and '
-                          '--restarts >= 0')
-    return IdentifySettings(
-        pop_size=args.pop_size, maxiter=args.generations, c=args.c, xi=args.xi,
-        seeds=tuple(range(args.seed_offset, args.seed_offset + args.seeds)),
-        workers=args.workers, refine=not args.gaass_only, restarts=args.restarts,
-        er_bound_percent=args.er_bound)
+    return config.make_settings(
+        seeds=args.seeds, seed_offset=args.seed_offset, pop_size=args.pop_size,
+        generations=args.generations, c=args.c, xi=args.xi, workers=args.workers,
+        refine=not args.gaass_only, restarts=args.restarts, er_bound_percent=args.er_bound)
 
 
 def make_spec(args: argparse.Namespace, rec: Recording) -> ChainSpec:
-    """Chain spec with the search domains asked for."""
-    choice = args.domains
-    if choice == 'auto':
-        return domains_from_data(rec)
-    if choice in PRESETS:
-        return preset_spec(choice, rec.channel)
-    try:
-        with open(choice) as f:
-            data = yaml.safe_load(f) or {}
-    except OSError as exc:
-        raise ConfigError(f'cannot read domains file {choice}: {exc.strerror}') from None
-    except yaml.YAMLError as exc:
-        raise ConfigError(f'domains file {choice} is not valid YAML: '
-                          f'{str(exc).splitlines()[0]}') from None
-    data = data.get('domains', data)
-    if not isinstance(data, dict):
-        raise ConfigError(f'domains file {choice} must map parameter names to [low, high]')
-    try:
-        domains = {str(k): (float(v[0]), float(v[1])) for k, v in data.items()}
-    except (TypeError, ValueError, IndexError):
-        raise ConfigError(f'domains file {choice}: each entry must be [low, high]') from None
-    return domains_from_data(rec, overrides=domains)
+    """Chain spec with the search domains asked for (``--domains``)."""
+    return config.make_spec(rec, args.domains)

@@ -16,7 +16,7 @@
 
 Without ``--sim`` the paper's chain of the channel is fitted on the first
 part of the record (``--train-fraction``, default 0.7) and the library of
-mechanisms is tested against the held-out rest (:mod:`hyst_id.diagnose`).
+mechanisms is tested against the held-out rest (:mod:`hyst_id.diagnosis`).
 With ``--sim PARAMS.yaml`` the rig simulator is driven by the recording's
 command instead, its found effects are switched on and the updated
 parameters written (``--sim-out``).
@@ -63,8 +63,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _settings(args: argparse.Namespace):
-    from hyst_id.diagnose import DiagnoseSettings
-    from hyst_id.diagnose.mechanisms import get_mechanisms
+    from hyst_id.diagnosis import DiagnoseSettings
+    from hyst_id.diagnosis.mechanisms import get_mechanisms
 
     if args.seeds < 1 or args.pop_size < 2 or args.generations < 1:
         raise ConfigError('need --seeds >= 1, --pop-size >= 2 and --generations >= 1')
@@ -83,8 +83,8 @@ def _settings(args: argparse.Namespace):
 
 def run(args: argparse.Namespace) -> int:
     """Diagnose and print the report."""
-    from hyst_id.diagnose import diagnose
-    from hyst_id.diagnose.report import plot_diagnosis
+    from hyst_id.diagnosis import diagnose
+    from hyst_id.diagnosis.report import plot_diagnosis
 
     settings = _settings(args)
     if not 0.0 < args.train_fraction < 1.0:
@@ -95,7 +95,7 @@ def run(args: argparse.Namespace) -> int:
           f'{rec.channel}', file=sys.stderr)
     updated = None
     if args.sim:
-        from hyst_id.diagnose.sim_compare import diagnose_sim
+        from hyst_id.diagnosis.sim_compare import diagnose_sim
         from hyst_id.rig import load_rig_params
         base = load_rig_params(args.sim)
         diag, updated = diagnose_sim(rec, base, settings=settings, progress=say)

@@ -28,7 +28,7 @@ import shutil
 import sys
 
 from hyst_id.errors import ConfigError
-from hyst_id.identify import IdentifySettings
+from hyst_id.identification import IdentifySettings
 
 __all__ = ['add_arguments', 'run', 'QUICK_SETTINGS', 'DEFAULT_PARAMS']
 
@@ -99,7 +99,7 @@ def run(args: argparse.Namespace) -> int:
     from dataclasses import replace
 
     from hyst_id.experiment import ExperimentConfig, MODES, run_experiment
-    from hyst_id.experiment_report import format_markdown, write_outputs
+    from hyst_id.experiment.report import format_markdown, write_outputs
 
     base = QUICK_SETTINGS if args.quick else IdentifySettings()
     n_seeds = args.seeds if args.seeds is not None else len(base.seeds)

@@ -26,7 +26,7 @@ from hyst_id.commands.common import (
     make_settings,
     make_spec,
 )
-from hyst_id.identify import identify
+from hyst_id.identification import identify
 
 __all__ = ['add_arguments', 'run']
 
@@ -44,7 +44,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Identify and print the report."""
-    from hyst_id.report import format_table, plot_identification, write_json
+    from hyst_id.identification.report import format_table, plot_identification, write_json
 
     rec = load_recording(args)
     spec = make_spec(args, rec)

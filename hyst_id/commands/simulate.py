@@ -31,8 +31,8 @@ import numpy as np
 import yaml
 
 from hyst_id.errors import ConfigError
-from hyst_id.excitation import EXCITATIONS, make_excitation
 from hyst_id.io.recording import CHANNELS
+from hyst_id.signals.excitation import EXCITATIONS, make_excitation
 
 __all__ = ['add_arguments', 'run', 'output_paths', 'sample_times']
 

@@ -72,11 +72,11 @@ from rosbags.typesys import (
 from hyst_id.errors import ConfigError, MissingTopicError, RecordingError
 from hyst_id.io.mcap_recover import lacks_footer, scan_records
 from hyst_id.io.messages import at_path, build_message, merge
+from hyst_id.io.topics import parse_field_path, TopicConfig
 
 if TYPE_CHECKING:
     from rosbags.typesys.store import Typestore
 
-    from hyst_id.io.readers import TopicConfig
     from hyst_id.io.recording import Recording
 
 __all__ = [
@@ -449,8 +449,6 @@ def write_recording_bag(path: str | Path, recording: Recording,
         The bag directory. Sample ``i`` has log time and ``header.stamp``
         (when the type has a header) ``start_ns + round(t_s[i] * 1e9)``.
     """
-    from hyst_id.io.readers import parse_field_path, TopicConfig
-
     cfg = topics if topics is not None else TopicConfig.for_channel(recording.channel)
     t_s = np.asarray(recording.t_s, dtype=float)
     command = np.asarray(recording.command, dtype=float)

@@ -71,7 +71,7 @@ def compensator_values(identification_or_dict: Any) -> dict[str, Any]:
     Parameters
     ----------
     identification_or_dict : Identification or mapping
-        An :class:`~hyst_id.identify.Identification` (its best canonical
+        An :class:`~hyst_id.identification.Identification` (its best canonical
         parameters are used), or a mapping with ``channel``, ``er_percent``
         and the parameters either flat or under ``params`` (the layout of
         ``Identification.to_dict()`` and of the identifier's JSON message).

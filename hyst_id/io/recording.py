@@ -28,12 +28,13 @@ import os
 import numpy as np
 
 from hyst_id.errors import NoExcitationError, RecordingError
+from hyst_id.signals.reversals import count_reversals
+from hyst_id.signals.split import split_index
 
 __all__ = [
     'CHANNELS',
     'Recording',
     'ROUNDOFF_PROBE_ENV',
-    'count_reversals',
     'roundoff_probe',
     'validate_recording',
 ]
@@ -116,48 +117,8 @@ class Recording:
         tuple of Recording
             ``(train, holdout)``.
         """
-        if not 0.0 < train_fraction < 1.0:
-            raise RecordingError(f'train fraction must be in (0, 1), got {train_fraction}')
-        t_cut = self.t_s[0] + train_fraction * self.duration_s
-        k = int(np.searchsorted(self.t_s, t_cut))
+        k = split_index(self.t_s, train_fraction)
         return self.window(0, k), self.window(k, self.n_samples)
-
-
-def count_reversals(command: np.ndarray, tolerance: float | None = None) -> int:
-    """Count direction reversals of a command, ignoring wiggles below a tolerance.
-
-    Parameters
-    ----------
-    command : numpy.ndarray
-        Command samples.
-    tolerance : float, optional
-        Smallest excursion that counts as a move; default 2 % of the
-        command's range.
-
-    Returns
-    -------
-    int
-        Number of times the command changes direction by more than the
-        tolerance.
-    """
-    command = np.asarray(command, dtype=float)
-    span = float(np.ptp(command)) if command.size else 0.0
-    if span <= 0.0:
-        return 0
-    tol = 0.02 * span if tolerance is None else float(tolerance)
-    reversals = 0
-    direction = 0
-    anchor = command[0]
-    for value in command[1:]:
-        if direction >= 0 and value < anchor - tol:
-            reversals += direction > 0
-            direction, anchor = -1, value
-        elif direction <= 0 and value > anchor + tol:
-            reversals += direction < 0
-            direction, anchor = 1, value
-        elif (direction > 0 and value > anchor) or (direction < 0 and value < anchor):
-            anchor = value
-    return int(reversals)
 
 
 def validate_recording(rec: Recording, *, min_samples: int = MIN_SAMPLES,

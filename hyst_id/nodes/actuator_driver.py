@@ -41,8 +41,8 @@ from std_msgs.msg import Float64
 
 from hyst_id.errors import ConfigError, InvalidParametersError
 from hyst_id.models.backlash import backlash_step, check_backlash
-from hyst_id.models.hysteresis import check_hysteresis, hysteresis_step, initial_output
-from hyst_id.nodes import (COMMAND_QOS, HystNode, Param, SENSOR_QOS, spin_node, topic_params)
+from hyst_id.models.tk import check_hysteresis, hysteresis_step, initial_output
+from hyst_id.nodes.support import COMMAND_QOS, HystNode, Param, SENSOR_QOS, spin_node, topic_params
 
 __all__ = ['ActuatorDriver', 'ActuatorInterface', 'PAPER_BACKLASH', 'PAPER_HYSTERESIS',
            'PARAMS', 'SimulatedActuator', 'main']
@@ -71,7 +71,7 @@ class SimulatedActuator(ActuatorInterface):
     """H then B, sample by sample, with the chains' initial state and optional noise.
 
     The first command puts H on the rising boundary of its major loop and B
-    on its rising edge (as :mod:`hyst_id.chains` assumes).
+    on its rising edge (as :mod:`hyst_id.identification.chains` assumes).
     """
 
     def __init__(self, hysteresis: dict[str, float] | None = None,

@@ -50,17 +50,25 @@ from rclpy.task import Future
 from std_msgs.msg import Float64
 
 from hyst_id.errors import HystIdError
-from hyst_id.io.readers import get_field, parse_field_path, TopicConfig
 from hyst_id.io.recording import CHANNELS
-from hyst_id.live import SampleBuffer
-from hyst_id.nodes import (COMMAND_QOS, DESIRED_TOPIC, HystNode, init_ros, message_class, Param,
-                           SENSOR_QOS, stamp_ns)
+from hyst_id.io.topics import get_field, parse_field_path, TopicConfig
+from hyst_id.live.buffer import SampleBuffer
 from hyst_id.nodes.actuator_driver import ActuatorDriver
 from hyst_id.nodes.compensator import Compensator
 from hyst_id.nodes.excitation import Excitation
 from hyst_id.nodes.identifier import Identifier
 from hyst_id.nodes.pipeline_sim import PipelineSim
 from hyst_id.nodes.recorder import Recorder
+from hyst_id.nodes.support import (
+    COMMAND_QOS,
+    DESIRED_TOPIC,
+    HystNode,
+    init_ros,
+    message_class,
+    Param,
+    SENSOR_QOS,
+    stamp_ns,
+)
 
 __all__ = ['Bringup', 'PARAMS', 'control_error_percent', 'main']
 

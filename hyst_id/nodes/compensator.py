@@ -48,12 +48,22 @@ from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from std_msgs.msg import Float64, String
 
-from hyst_id.compensate import CommandLimits, Compensator as CoreCompensator, InverseModel
+from hyst_id.compensation import CommandLimits, InverseModel
+from hyst_id.compensation import Compensator as CoreCompensator
 from hyst_id.errors import InvalidParametersError
 from hyst_id.io.params_file import COMPENSATOR_NAMES
 from hyst_id.io.recording import CHANNELS
-from hyst_id.nodes import (COMMAND_QOS, DESIRED_TOPIC, HystNode, IDENTIFIED_PARAMS_TOPIC,
-                           LATCHED_QOS, Param, spin_node, topic_params, try_publish)
+from hyst_id.nodes.support import (
+    COMMAND_QOS,
+    DESIRED_TOPIC,
+    HystNode,
+    IDENTIFIED_PARAMS_TOPIC,
+    LATCHED_QOS,
+    Param,
+    spin_node,
+    topic_params,
+    try_publish,
+)
 
 __all__ = ['ACTIVE_SET_QOS', 'Compensator', 'PARAMS', 'main']
 

@@ -12,7 +12,7 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
-"""Excitation node: publishes a command profile of :mod:`hyst_id.excitation`.
+"""Excitation node: publishes a command profile of :mod:`hyst_id.signals.excitation`.
 
 Profiles: Eq. 24 and Eq. 25 of the paper (any sine, through their
 parameters), multisine, chirp, steps.
@@ -36,20 +36,31 @@ import numpy as np
 from std_msgs.msg import Float64
 
 from hyst_id.errors import ConfigError
-from hyst_id.excitation import (DEFAULT_MULTISINE_HZ, DEFAULT_STEP_LEVELS_MA, EXCITATIONS,
-                                make_excitation)
-from hyst_id.nodes import COMMAND_QOS, HystNode, Param, spin_node, topic_params, try_publish
+from hyst_id.nodes.support import (
+    COMMAND_QOS,
+    HystNode,
+    Param,
+    spin_node,
+    topic_params,
+    try_publish,
+)
+from hyst_id.signals.excitation import (
+    DEFAULT_MULTISINE_HZ,
+    DEFAULT_STEP_LEVELS_MA,
+    EXCITATIONS,
+    make_excitation,
+)
 
 __all__ = ['Excitation', 'PARAMS', 'main', 'profile_kwargs']
 
 _NAN = math.nan
-#: Node parameter -> keyword of the profile functions in hyst_id.excitation.
+#: Node parameter -> keyword of the profile functions in hyst_id.signals.excitation.
 _KWARGS = ('offset_ma', 'amplitude_ma', 'period_s', 'decay_per_s', 'frequencies_hz', 'f0_hz',
            'f1_hz', 'sweep_s', 'levels_ma', 'hold_s')
 _PROFILE_KEYS = ('profile',) + _KWARGS
 
 PARAMS = [
-    Param('profile', 'eq24', 'command profile (hyst_id.excitation)',
+    Param('profile', 'eq24', 'command profile (hyst_id.signals.excitation)',
           choices=tuple(EXCITATIONS)),
     Param('offset_ma', _NAN, "offset (eq24, eq25, multisine, chirp); .nan = the profile's "
           'default (9 mA)', unit='mA'),

@@ -19,8 +19,8 @@ jobs, result documents); ``docs/nodes.md`` describes topics, parameters and
 behaviour. Measurements are timed by ``header.stamp`` (``stamp_source:
 header``) or, like commands, by the publisher's source timestamp; samples
 arriving out of order are sorted and gaps are reported in the result's
-``notes``. Identification (:func:`hyst_id.identify.identify`, as ``hyst-id
-identify``) and diagnosis (:func:`hyst_id.diagnose.diagnose`) run in worker
+``notes``. Identification (:func:`hyst_id.identification.identify`, as ``hyst-id
+identify``) and diagnosis (:func:`hyst_id.diagnosis.diagnose`) run in worker
 threads, never on the executor; triggers are the end of a run, the
 ``identify_now`` / ``cancel_now`` / ``diagnose_now`` parameters and the
 ``~/identify`` / ``~/cancel`` / ``~/diagnose`` services. A failed or
@@ -30,7 +30,6 @@ restart republishes the set of the params file the node wrote.
 
 from __future__ import annotations
 
-import argparse
 from concurrent.futures import ThreadPoolExecutor
 import json
 import math
@@ -44,18 +43,40 @@ from rclpy.parameter import Parameter
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 from std_msgs.msg import Float64, String
 
-from hyst_id.commands.common import make_settings, make_spec
 from hyst_id.errors import ConfigError, HystIdError
-from hyst_id.identify import Identification, IdentifySettings
-from hyst_id.io.params_file import (compensator_values, read_compensator_params,
-                                    write_compensator_params)
-from hyst_id.io.readers import get_field, parse_field_path, TopicConfig
+from hyst_id.identification import Identification, IdentifySettings
+from hyst_id.identification.config import make_settings, make_spec
+from hyst_id.io.params_file import (
+    compensator_values,
+    read_compensator_params,
+    write_compensator_params,
+)
 from hyst_id.io.recording import CHANNELS, Recording, validate_recording
-from hyst_id.live import (diagnosis_statuses, DiagnosisJob, IdentificationJob,
-                          recovered_document, result_document, SampleBuffer, warm_up_kernels)
-from hyst_id.nodes import (COMMAND_QOS, diagnostic_array, field_params, HystNode,
-                           IDENTIFIED_PARAMS_TOPIC, LATCHED_QOS, message_class, Param,
-                           ParameterPusher, source_time_ns, spin_node, stamp_ns, topic_params)
+from hyst_id.io.topics import get_field, parse_field_path, TopicConfig
+from hyst_id.live import (
+    diagnosis_statuses,
+    DiagnosisJob,
+    IdentificationJob,
+    recovered_document,
+    result_document,
+    SampleBuffer,
+    warm_up_kernels,
+)
+from hyst_id.nodes.support import (
+    COMMAND_QOS,
+    diagnostic_array,
+    field_params,
+    HystNode,
+    IDENTIFIED_PARAMS_TOPIC,
+    LATCHED_QOS,
+    message_class,
+    Param,
+    ParameterPusher,
+    source_time_ns,
+    spin_node,
+    stamp_ns,
+    topic_params,
+)
 
 try:  # optional: std_srvs is not a dependency of the package
     from std_srvs.srv import Trigger
@@ -257,7 +278,7 @@ class Identifier(HystNode):
             return False, self._busy()
         try:
             rec = validate_recording(self._recording())
-            spec = make_spec(argparse.Namespace(domains=self.p('domains')), rec)
+            spec = make_spec(rec, self.p('domains'))
             self.job = IdentificationJob(rec, spec, self.settings())
         except HystIdError as exc:
             self._fail(f'cannot identify ({why}): {exc}; {self._kept()}')
@@ -317,11 +338,11 @@ class Identifier(HystNode):
     def settings(self) -> IdentifySettings:
         """GAASS settings from the parameters, built as ``hyst-id identify`` builds them."""
         bound = self.p('er_bound_percent')
-        return make_settings(argparse.Namespace(
+        return make_settings(
             seeds=self.p('seeds'), seed_offset=self.p('seed_offset'),
             pop_size=self.p('pop_size'), generations=self.p('generations'), c=self.p('c'),
-            xi=self.p('xi'), workers=self.p('workers'), gaass_only=not self.p('refine'),
-            restarts=self.p('restarts'), er_bound=bound if bound > 0 else None))
+            xi=self.p('xi'), workers=self.p('workers'), refine=self.p('refine'),
+            restarts=self.p('restarts'), er_bound_percent=bound if bound > 0 else None)
 
     def _kept(self) -> str:
         doc = self.last_document

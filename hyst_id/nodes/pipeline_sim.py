@@ -52,10 +52,10 @@ from std_msgs.msg import Float64
 
 from hyst_id.errors import ConfigError, InvalidParametersError
 from hyst_id.models.backlash import check_backlash
-from hyst_id.models.hysteresis import check_hysteresis
 from hyst_id.models.sensors import first_order_coefficient, second_order_coefficients
-from hyst_id.nodes import (COMMAND_QOS, HystNode, Param, SENSOR_QOS, spin_node, topic_params)
+from hyst_id.models.tk import check_hysteresis
 from hyst_id.nodes.actuator_driver import PAPER_BACKLASH, PAPER_HYSTERESIS, SimulatedActuator
+from hyst_id.nodes.support import COMMAND_QOS, HystNode, Param, SENSOR_QOS, spin_node, topic_params
 
 __all__ = ['PARAMS', 'PipelineSim', 'PlantModel', 'PlantReading', 'RigPlant', 'SimplePlant',
            'main', 'make_plant']

@@ -43,12 +43,20 @@ import threading
 from typing import Any
 
 import rclpy
-from rclpy.qos import (DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy)
+from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
 from hyst_id.errors import ConfigError
 from hyst_id.io.bag import BagWriter
-from hyst_id.nodes import (DESIRED_TOPIC, HystNode, IDENTIFIED_PARAMS_TOPIC, message_class,
-                           Param, source_time_ns, spin_node, topic_params)
+from hyst_id.nodes.support import (
+    DESIRED_TOPIC,
+    HystNode,
+    IDENTIFIED_PARAMS_TOPIC,
+    message_class,
+    Param,
+    source_time_ns,
+    spin_node,
+    topic_params,
+)
 
 __all__ = ['PARAMS', 'Recorder', 'default_bag_name', 'main']
 

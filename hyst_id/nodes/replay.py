@@ -36,7 +36,7 @@ from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPo
 
 from hyst_id.errors import ConfigError, HystIdError, RecordingError
 from hyst_id.io.bag import default_typestore, iter_bag_messages, open_bag
-from hyst_id.nodes import (HystNode, IDENTIFIED_PARAMS_TOPIC, init_ros, message_class, Param)
+from hyst_id.nodes.support import HystNode, IDENTIFIED_PARAMS_TOPIC, init_ros, message_class, Param
 
 __all__ = ['PARAMS', 'Replay', 'main']
 

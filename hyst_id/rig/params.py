@@ -45,7 +45,7 @@ import numpy as np
 
 from hyst_id.errors import ConfigError, InvalidParametersError
 from hyst_id.models.backlash import check_backlash
-from hyst_id.models.hysteresis import check_hysteresis
+from hyst_id.models.tk import check_hysteresis
 from hyst_id.rig.effects import Effects
 from hyst_id.rig.physics import FLOW_MODELS, STANDARD_ATMOSPHERE_PA
 

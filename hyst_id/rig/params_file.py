@@ -30,8 +30,13 @@ import yaml
 
 from hyst_id.errors import ConfigError
 from hyst_id.io.params_file import read_yaml
-from hyst_id.rig.params import (_merge, _unflatten, rig_params_from_dict, rig_params_to_dict,
-                                RigParams)
+from hyst_id.rig.params import (
+    _merge,
+    _unflatten,
+    rig_params_from_dict,
+    rig_params_to_dict,
+    RigParams,
+)
 
 __all__ = ['DEFAULT_NODE', 'as_rig_params', 'load_rig_params', 'save_rig_params']
 

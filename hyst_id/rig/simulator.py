@@ -39,11 +39,18 @@ import numpy as np
 from hyst_id.errors import ConfigError, RecordingError
 from hyst_id.io.recording import CHANNELS, Recording
 from hyst_id.models.backlash import backlash_step
-from hyst_id.models.hysteresis import hysteresis_step, initial_output
 from hyst_id.models.sensors import first_order_coefficient, second_order_coefficients
-from hyst_id.rig.effects import (CHARACTERISTIC_KINDS, DELAY_CAPACITY, delay_lookup,
-                                 delay_push, end_stop, rate_filter_step, stick_slip_step,
-                                 valve_area_fraction)
+from hyst_id.models.tk import hysteresis_step, initial_output
+from hyst_id.rig.effects import (
+    CHARACTERISTIC_KINDS,
+    DELAY_CAPACITY,
+    delay_lookup,
+    delay_push,
+    end_stop,
+    rate_filter_step,
+    stick_slip_step,
+    valve_area_fraction,
+)
 from hyst_id.rig.params import RigParams
 from hyst_id.rig.params_file import as_rig_params
 from hyst_id.rig.physics import FLOW_MODELS, pneumatic_step, steady_state, vessel_mass

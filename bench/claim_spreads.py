@@ -1,0 +1,119 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""Spread of the diagnosis figures the tests assert on, over seeds and round-off.
+
+A threshold in a test must sit well outside what the computation gives on
+other noise seeds and on another CPU make. This script measures that spread
+for the statistical claims of ``test/diagnose``: every mechanism's synthetic
+record over ``--seeds`` noise seeds, each also under the round-off probe
+(``HYST_ID_ROUNDOFF_PROBE``, imitating another CPU's last bits), and the
+concealed bags under ``--probes`` probe seeds. It prints, per claim, how
+often the verdict is right and the distribution of the figures the tests
+bound (held-out gain, final held-out over the noise floor).
+
+Run from the repository root (about 40 minutes on 2 cores)::
+
+    python bench/claim_spreads.py
+    python bench/claim_spreads.py --only stiction --seeds 24
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+from pathlib import Path
+import sys
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / 'test' / 'diagnosis'))
+sys.path.insert(0, str(ROOT))
+
+from hyst_id.diagnosis import diagnose  # noqa: E402
+from hyst_id.io.readers import read_recording  # noqa: E402
+
+
+def _probe(seed: int | None) -> None:
+    if seed is None:
+        os.environ.pop('HYST_ID_ROUNDOFF_PROBE', None)
+    else:
+        os.environ['HYST_ID_ROUNDOFF_PROBE'] = f'{seed}:1e-12'
+
+
+def _row(name: str, verdicts: list[bool], gains: list[float], ratios: list[float]) -> str:
+    g, r = np.array(gains), np.array(ratios)
+    return (f'{name:24s} named {sum(verdicts):2d}/{len(verdicts):2d}  '
+            f'gain min {g.min():6.1%} med {np.median(g):6.1%} max {g.max():6.1%}  '
+            f'final/floor min {r.min():5.2f} med {np.median(r):5.2f} max {r.max():5.2f}')
+
+
+def synthetic_spreads(mechs: list[str], seeds: list[int], probes: list[int | None]) -> None:
+    """Each mechanism's synthetic record over seeds and probes."""
+    from test_diagnose import FAST, synthetic
+    print('synthetic records (test/diagnosis/test_diagnose.py), '
+          f'seeds {seeds[0]}..{seeds[-1]}, probes {probes}')
+    for mech in mechs:
+        verdicts, gains, ratios = [], [], []
+        for seed in seeds:
+            for probe in probes:
+                _probe(probe)
+                d = diagnose(synthetic(mech, seed=seed), settings=FAST)
+                verdicts.append(d.verdict == mech)
+                b, f = d.baseline.er_holdout_percent, d.final.er_holdout_percent
+                gains.append(1.0 - f / b)
+                ratios.append(f / d.noise_floor_percent)
+        print(_row(mech, verdicts, gains, ratios), flush=True)
+    _probe(None)
+
+
+def bag_spreads(probes: list[int | None]) -> None:
+    """The concealed bags under round-off probes."""
+    from test_concealed_bags import CASES, SETTINGS
+    print(f'concealed bags (test/diagnosis/test_concealed_bags.py), probes {probes}')
+    for name in sorted(CASES):
+        channel, _, _, _, expected = CASES[name]
+        verdicts, gains, ratios = [], [], []
+        for probe in probes:
+            _probe(probe)
+            d = diagnose(read_recording(ROOT / 'bags' / name, channel), settings=SETTINGS)
+            verdicts.append(d.verdict == expected)
+            b, f = d.baseline.er_holdout_percent, d.final.er_holdout_percent
+            gains.append(1.0 - f / b)
+            ratios.append(f / d.noise_floor_percent)
+        print(_row(f'{name} ({expected})', verdicts, gains, ratios), flush=True)
+    _probe(None)
+
+
+def main() -> int:
+    """Print the spreads."""
+    from hyst_id.diagnosis.mechanisms import MECHANISM_IDS
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument('--seeds', type=int, default=10, help='noise seeds per mechanism (from 5)')
+    ap.add_argument('--probes', type=int, default=2, help='round-off probe seeds (plus none)')
+    ap.add_argument('--only', default='', help='comma-separated mechanisms, or "bags"')
+    args = ap.parse_args()
+    probes = [None] + list(range(1, args.probes + 1))
+    only = [m for m in args.only.split(',') if m]
+    mechs = [m for m in MECHANISM_IDS if not only or m in only]
+    if mechs and only != ['bags']:
+        synthetic_spreads(mechs, list(range(5, 5 + args.seeds)), probes[:2])
+    if not only or 'bags' in only:
+        bag_spreads(probes)
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())

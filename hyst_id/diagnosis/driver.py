@@ -1,0 +1,266 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""Diagnosis: where a recording departs from the paper's chain, which physics is missing.
+
+``diagnose(recording)``
+
+1. splits the record in time (default: the first 70 % trains, the rest is
+   held out) and fits the paper's chain of the channel on the training part
+   (GAASS with a few seeds, refined), in a normalised command scale unless a
+   chain spec is given;
+2. locates the mismatch in the residual (:mod:`hyst_id.diagnosis.locate`);
+3. inserts every mechanism of the library (:mod:`hyst_id.diagnosis.mechanisms`)
+   at its place in the chain, refits locally from the baseline and keeps the
+   best one the data support (:mod:`hyst_id.diagnosis.select`); repeats once
+   more if the residual still has structure;
+4. returns a :class:`Diagnosis` whose :meth:`~Diagnosis.to_dict` is the
+   ``--json`` document and whose :meth:`~Diagnosis.report` is the text report.
+
+When the baseline residual is white, independent of the command and at the
+noise floor on held-out data, no mechanism is tested and the verdict is
+``none``.
+"""
+
+from __future__ import annotations
+
+from typing import Callable
+
+import numpy as np
+from threadpoolctl import threadpool_limits
+
+from hyst_id.diagnosis.baseline import baseline_starts
+from hyst_id.diagnosis.locate import Localization, locate, noise_std
+from hyst_id.diagnosis.mechanisms import get_mechanisms
+from hyst_id.diagnosis.mechanisms.base import Context, Mechanism
+from hyst_id.diagnosis.model import ComposedModel
+from hyst_id.diagnosis.result import DiagnoseSettings, Diagnosis, Finding
+from hyst_id.diagnosis.select import (
+    choose,
+    compare,
+    Comparison,
+    Data,
+    evaluate,
+    fit_model,
+    FitResult,
+    polish,
+    round_record,
+)
+from hyst_id.errors import ConfigError, RecordingError
+from hyst_id.identification.chains import chain_spec, ChainSpec
+from hyst_id.io.recording import Recording, validate_recording
+from hyst_id.signals.noise import floor_percent
+from hyst_id.signals.reversals import period_s
+from hyst_id.signals.split import split_index
+
+__all__ = ['diagnose', 'finding_from', 'located_where', 'range_note']
+
+
+def _info(fit: FitResult, ctx: Context, command: np.ndarray) -> dict:
+    """What :meth:`Mechanism.describe` needs to turn a block's numbers into units."""
+    model = fit.model
+    x_chain = fit.p[:model.n_chain]
+    th = {m.id: model.theta(fit.p, m.id) for m in model.mechanisms}
+    n_basis = sum(1 for lab in fit.labels if lab == 'sensor' or lab.startswith('quantity:'))
+
+    def to_meas(x: np.ndarray) -> np.ndarray:
+        basis = [np.asarray(x, dtype=float)]
+        for m in model.mechanisms:
+            if m.stage == 'quantity':
+                basis = m.quantity(th[m.id], basis[0], fit.span) or basis
+        return sum(c * b for c, b in zip(fit.coef[:n_basis], basis)) + fit.offset_at_start
+
+    lo, hi = fit.span
+    ends = to_meas(np.array([lo, hi]))
+    a = ctx.command_scale[0]
+    return {'coef': fit.coef, 'labels': fit.labels, 'span': fit.span, 'x_chain': x_chain,
+            'to_meas': to_meas, 'meas_per_pos': float((ends[1] - ends[0]) / (hi - lo)),
+            'pos_per_cmd': float(x_chain[1] * x_chain[8] / a), 'command': command,
+            'travel_raw': fit.travel_raw}
+
+
+def located_where(loc: Localization, own: dict) -> dict:
+    """The ``where`` of a finding: located windows, regimes, trend, spectrum, correlation."""
+    bad = sorted((w for w in loc.windows if w['flagged']), key=lambda w: -w['rms_ratio'])
+    regimes = {k: [{'range': b['label'], 'rms_ratio': b['rms_ratio'], 'mean': b['mean']}
+                   for b in bins if b['flagged']] for k, bins in loc.regimes.items()}
+    out = {'time_windows_s': [[w['t_start_s'], w['t_end_s']] for w in bad[:6]],
+           'regimes': {k: v for k, v in regimes.items() if v},
+           'trend_per_s': loc.trend['slope_per_s'] if loc.trend['significant'] else 0.0,
+           'frequencies': {'f0_hz': loc.spectrum['f0_hz'],
+                           'below_f0_fraction': loc.spectrum['low_fraction'],
+                           'harmonic_fraction': loc.spectrum['harmonic_fraction']},
+           'correlation': {'white': loc.white, 'ljung_box_p': loc.ljung_box['p'],
+                           'command': {'r': loc.ccf_command['peak_r'],
+                                       'lag_s': loc.ccf_command['peak_lag_s'],
+                                       'bound': loc.ccf_command['bound']},
+                           'command_rate': {'r': loc.ccf_rate['peak_r'],
+                                            'lag_s': loc.ccf_rate['peak_lag_s'],
+                                            'bound': loc.ccf_rate['bound']}}}
+    out['evidence'] = own
+    return out
+
+
+def finding_from(comp: Comparison, before: FitResult, mech: Mechanism, loc: Localization,
+                 ctx: Context, command: np.ndarray) -> Finding:
+    """Turn an accepted comparison into a :class:`Finding` with words and units."""
+    fit = comp.fit
+    theta = fit.model.theta(fit.p, mech.id)
+    values = mech.describe(theta, fit.coef, _info(fit, ctx, command), ctx)
+    where = located_where(loc, comp.where)
+    return Finding(mechanism=mech.id, title=mech.title, placement=mech.placement,
+                   explanation=mech.explain(values, where, ctx), where=where, params=values,
+                   er_train_before_percent=before.er_train_percent,
+                   er_train_after_percent=fit.er_train_percent,
+                   er_holdout_before_percent=before.er_holdout_percent,
+                   er_holdout_after_percent=fit.er_holdout_percent,
+                   delta_bic=comp.delta_bic, holdout_z=comp.holdout_z)
+
+
+def diagnose(recording: Recording, *, spec: ChainSpec | None = None,
+             settings: DiagnoseSettings | None = None,
+             progress: Callable[[str], None] | None = None) -> Diagnosis:
+    """Diagnose what a recording has that the paper's chain of its channel lacks.
+
+    Parameters
+    ----------
+    recording : Recording
+        Command and one measured channel (validated here).
+    spec : ChainSpec, optional
+        Chain spec with search domains in the recording's own command units.
+        Default: the paper's domains on a normalised command (the command's
+        training range mapped to 7-11, the range of the paper's Eq. 24).
+    settings : DiagnoseSettings, optional
+        Split, baseline GAASS settings, mechanisms, criteria.
+    progress : callable, optional
+        Called with a short message at each step.
+
+    Returns
+    -------
+    Diagnosis
+    """
+    settings = settings or DiagnoseSettings()
+    say = progress or (lambda msg: None)
+    with threadpool_limits(limits=1):   # small dense problems: one BLAS thread is fastest
+        return _diagnose(recording, spec, settings, say)
+
+
+def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSettings,
+              say: Callable[[str], None]) -> Diagnosis:
+    rec = validate_recording(recording)
+    mechs = get_mechanisms(settings.mechanisms)
+    t, v_orig, y = rec.t_s, rec.command, rec.measurement
+    n_train = split_index(t, settings.train_fraction)
+    if n_train < 20 or t.size - n_train < 10:
+        raise RecordingError(f'record too short to split: {n_train} training and '
+                             f'{t.size - n_train} held-out samples')
+    if spec is None:
+        lo, hi = float(np.min(v_orig[:n_train])), float(np.max(v_orig[:n_train]))
+        half = 0.5 * (hi - lo) if hi > lo else 1.0
+        scale = (half / 2.0, 0.5 * (lo + hi) - 9.0 * half / 2.0)
+        spec = chain_spec(rec.channel)
+    else:
+        if spec.channel != rec.channel:
+            raise ConfigError(f'chain spec is for {spec.channel!r}, recording is {rec.channel!r}')
+        scale = (1.0, 0.0)
+    v = (v_orig - scale[1]) / scale[0]
+    rec_train = Recording(t[:n_train], v[:n_train], y[:n_train], rec.channel, source=rec.source)
+    validate_recording(rec_train)
+    ctx = Context(channel=rec.channel, t_s=t, n_train=n_train, command_scale=scale,
+                  command_unit=rec.command_unit, measurement_unit=rec.measurement_unit,
+                  extra={'period_s': period_s(t[:n_train], v[:n_train])})
+    sigma = noise_std(y)
+    data = Data(t_s=t, v=v, y=y, n_train=n_train, noise_std=sigma)
+    say(f'baseline: GAASS x {len(settings.seeds)} seeds on the first {n_train} samples')
+    base_model = ComposedModel(rec.channel, [], ctx, spec.bounds)
+    x_ga, starts = baseline_starts(rec_train, spec, settings)
+    polished = sorted((polish(base_model, data, x0, max_nfev=2 * settings.fit_budget) + (x0,)
+                       for x0 in [x_ga] + starts), key=lambda z: z[1])
+    baseline = evaluate(base_model, data, polished[0][0], polished[0][2])
+    # the neutral data-built starts whose basins fitted best seed the mechanism fits
+    chain_starts = [z[3] for z in polished if any(z[3] is s for s in starts)][:2]
+    floor_h = floor_percent(y[n_train:], sigma)
+    floor_t = floor_percent(y[:n_train], sigma)
+    loc0 = locate(t, v_orig, y, baseline.prediction, sigma, n_train, ctx.period_s)
+    say(f'baseline: %e_r train {baseline.er_train_percent:.4g}, held-out '
+        f'{baseline.er_holdout_percent:.4g} (noise floor {floor_h:.3g})')
+    current, loc, findings, rounds = baseline, loc0, [], []
+    for round_no in range(settings.max_mechanisms):
+        if not loc.structured and current.er_holdout_percent <= 1.5 * floor_h:
+            break
+        if round_no > 0 and current.er_holdout_percent <= 1.2 * floor_h:
+            break   # what structure is left is within the noise on held-out data
+        done = set(current.ids)
+        comps = []
+        for m in mechs:
+            if m.id in done:
+                continue
+            say(f'round {round_no + 1}: testing {m.id}')
+            comps.append(_try(m, current, data, ctx, settings, loc, chain_starts))
+        winner, tied = choose(comps, data, settings.criteria)
+        rounds.append(round_record(round_no + 1, comps, winner))
+        if winner is None:
+            break
+        mech = next(m for m in mechs if m.id == winner.mechanism)
+        findings.append(finding_from(winner, current, mech, loc, ctx, v_orig))
+        findings[-1].alternatives = [{'mechanism': c.mechanism,
+                                      'er_holdout_after_percent': c.fit.er_holdout_percent}
+                                     for c in tied]
+        current = winner.fit
+        loc = locate(t, v_orig, y, current.prediction, sigma, n_train, ctx.period_s)
+    final_loc = loc if current is not baseline else loc0
+    notes = list(rec.notes) + range_note(v_orig, n_train)
+    return Diagnosis(channel=rec.channel, source=rec.source, mode='model',
+                     verdict=findings[0].mechanism if findings else 'none', t_s=t,
+                     command=v_orig, measurement=y, n_train=n_train, baseline=baseline,
+                     final=current, findings=findings, localization=loc0,
+                     final_localization=final_loc, noise_std=sigma,
+                     noise_floor_percent=floor_h, noise_floor_train_percent=floor_t,
+                     rounds=rounds, baseline_params=_chain_dict(rec.channel, baseline.p),
+                     measurement_unit=rec.measurement_unit, command_unit=rec.command_unit,
+                     notes=notes, extra={'command_scale': list(scale)})
+
+
+def range_note(v: np.ndarray, n_train: int) -> list[str]:
+    """A warning when the held-out command leaves the training range (extrapolation)."""
+    lo_t, hi_t = float(np.min(v[:n_train])), float(np.max(v[:n_train]))
+    lo_h, hi_h = float(np.min(v[n_train:])), float(np.max(v[n_train:]))
+    if max(lo_t - lo_h, hi_h - hi_t) > 0.05 * (hi_t - lo_t):
+        return [f'the held-out command reaches {lo_h:.4g} to {hi_h:.4g}, beyond the training '
+                f'range {lo_t:.4g} to {hi_t:.4g}: held-out errors there are extrapolation of '
+                'the model, not necessarily missing physics']
+    return []
+
+
+def _chain_dict(channel: str, p: np.ndarray) -> dict:
+    names = chain_spec(channel).names
+    return {n: float(x) for n, x in zip(names, p[:len(names)])}
+
+
+def _try(m: Mechanism, current: FitResult, data: Data, ctx: Context,
+         settings: DiagnoseSettings, loc: Localization,
+         chain_starts: list[np.ndarray]) -> Comparison:
+    prev = current.model
+    model = ComposedModel(ctx.channel, list(prev.mechanisms) + [m], ctx,
+                          prev.bounds[:prev.n_chain])
+    thetas = {pm.id: prev.theta(current.p, pm.id) for pm in prev.mechanisms}
+    p_prev = model.pack(current.p[:prev.n_chain], thetas)
+    fit = fit_model(model, data, p_prev, m, budget=settings.fit_budget,
+                    chain_starts=chain_starts)
+    comp = compare(current, fit, data, m.id, settings.criteria)
+    comp.evidence, comp.where = m.evidence(loc)
+    reason = m.implausible(model.theta(fit.p, m.id), fit.coef, fit.span, data.noise_std)
+    if reason and comp.accepted:
+        comp.accepted, comp.status = False, f'rejected: {reason}'
+    return comp

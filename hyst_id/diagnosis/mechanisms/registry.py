@@ -1,0 +1,55 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""The registry of mechanisms: one line per mechanism module.
+
+Adding a mechanism is one module exposing ``MECHANISM`` (an instance of a
+:class:`~hyst_id.diagnosis.mechanisms.base.Mechanism` subclass) and one entry
+in :data:`MODULES` below (see ``docs/diagnosis.md``, "Adding a mechanism").
+"""
+
+from __future__ import annotations
+
+from hyst_id.diagnosis.mechanisms import (
+    dead_time,
+    offset_drift,
+    rate_dependence,
+    saturation,
+    sensor_lag,
+    static_nonlinearity,
+    stiction,
+    supply_decay,
+)
+from hyst_id.diagnosis.mechanisms.base import Context, Mechanism, Quantity
+from hyst_id.errors import ConfigError
+
+__all__ = ['MECHANISMS', 'MECHANISM_IDS', 'Context', 'Mechanism', 'Quantity', 'get_mechanisms']
+
+#: Every mechanism by id, in the issue's order.
+MECHANISMS: dict[str, Mechanism] = {m.MECHANISM.id: m.MECHANISM for m in (
+    dead_time, sensor_lag, supply_decay, offset_drift, saturation, stiction,
+    static_nonlinearity, rate_dependence)}
+
+#: The ids alone.
+MECHANISM_IDS = tuple(MECHANISMS)
+
+
+def get_mechanisms(ids=None) -> list[Mechanism]:
+    """Mechanisms by id (all when ``ids`` is None); unknown ids raise ConfigError."""
+    if ids is None:
+        return list(MECHANISMS.values())
+    unknown = [i for i in ids if i not in MECHANISMS]
+    if unknown:
+        raise ConfigError(f'unknown mechanism(s) {unknown}; known: {list(MECHANISM_IDS)}')
+    return [MECHANISMS[i] for i in ids]

@@ -1,0 +1,188 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""Text report and figure of a :class:`~hyst_id.diagnosis.Diagnosis`."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+__all__ = ['format_diagnosis', 'plot_diagnosis']
+
+
+def _fmt(x: float) -> str:
+    return f'{x:.4g}' if np.isfinite(x) else 'n/a'
+
+
+def _params_lines(params: dict) -> list[str]:
+    out = []
+    for name, q in params.items():
+        meaning = f'  ({q.meaning})' if q.meaning else ''
+        out.append(f'      {name} = {q.value:.4g} {q.unit}{meaning}')
+    return out
+
+
+def format_diagnosis(d: Any) -> str:
+    """Plain-text report: where, what physics, fitted block, held-out errors, tests."""
+    t = d.t_s
+    nt = d.n_train
+    unit = d.measurement_unit
+    mode = ' (simulator vs recording)' if d.mode == 'sim' else ''
+    lines = [f'diagnosis of {d.source or "recording"}: channel {d.channel}, {t.size} samples '
+             f'over {t[-1] - t[0]:.1f} s{mode}',
+             f'split: trained on {t[0]:.1f}-{t[nt - 1]:.1f} s ({nt} samples), held out '
+             f'{t[nt]:.1f}-{t[-1]:.1f} s ({t.size - nt} samples)']
+    what = 'the simulator as given' if d.mode == 'sim' else "the paper's chain"
+    lines.append(f'baseline ({what}): %e_r train {_fmt(d.baseline.er_train_percent)}, held-out '
+                 f'{_fmt(d.baseline.er_holdout_percent)}; noise floor '
+                 f'{_fmt(d.noise_floor_percent)} held-out / {_fmt(d.noise_floor_train_percent)} '
+                 f'train (noise std {d.noise_std:.3g}{" " + unit if unit else ""})')
+    lines += ['', 'where the baseline departs from the measurement:']
+    lines += [f'  - {s}' for s in d.localization.summary(unit)]
+    lines.append('')
+    if not d.findings:
+        if not d.rounds:
+            lines.append('verdict: none - the baseline residual is white, independent of the '
+                         'command and at the noise floor on held-out data: this record shows no '
+                         'physics that the model leaves out.')
+        else:
+            ratio = d.baseline.er_holdout_percent / d.noise_floor_percent
+            lines.append('verdict: none - no mechanism of the library improves the held-out '
+                         'error significantly (table below). The remaining mismatch '
+                         f'({ratio:.2f} x the noise floor on held-out data) is not one of the '
+                         'modelled physics.')
+    for i, f in enumerate(d.findings):
+        head = 'verdict' if i == 0 else f'finding {i + 1}'
+        gain = 100 * (1 - f.er_holdout_after_percent / f.er_holdout_before_percent)
+        lines += [f'{head}: {f.mechanism} - {f.title}', f'    {f.explanation}',
+                  f'    placed: {f.placement}', '    fitted block:']
+        lines += _params_lines(f.params)
+        lines.append(f'    held-out %e_r {_fmt(f.er_holdout_before_percent)} -> '
+                     f'{_fmt(f.er_holdout_after_percent)} ({-gain:+.0f} %); training '
+                     f'{_fmt(f.er_train_before_percent)} -> {_fmt(f.er_train_after_percent)}; '
+                     f'delta BIC {f.delta_bic:.0f}, held-out z {f.holdout_z:.1f}')
+        if f.alternatives:
+            alts = ', '.join(f'{a["mechanism"]} (held-out {a["er_holdout_after_percent"]:.4g})'
+                             for a in f.alternatives)
+            lines.append(f'    also consistent with the data (tied, decided by training BIC '
+                         f'and evidence): {alts}')
+        lines.append('')
+    if d.findings:
+        fin = d.final
+        ratio = fin.er_holdout_percent / d.noise_floor_percent
+        lines.append(f'final model: baseline + {" + ".join(fin.ids)}: %e_r train '
+                     f'{_fmt(fin.er_train_percent)}, held-out {_fmt(fin.er_holdout_percent)} '
+                     f'= {ratio:.2f} x the noise floor')
+        fl = d.final_localization
+        lines.append('remaining residual: ' + ('white and independent of the command'
+                                               if not fl.structured else
+                                               'still structured: ' + '; '.join(
+                                                   fl.summary(unit)[1:3])))
+    for r in d.rounds:
+        lines += ['', f'mechanisms tested (round {r["round"]}):',
+                  f'  {"mechanism":22s}{"held-out %e_r":>14s}{"gain":>8s}{"share":>7s}'
+                  f'{"dBIC":>9s}{"z":>9s}  status']
+        for c in sorted(r['candidates'], key=lambda c: c['er_holdout_percent']):
+            status = c['status'] + (' (chosen)' if c['chosen'] else '')
+            lines.append(f'  {c["mechanism"]:22s}{c["er_holdout_percent"]:14.4g}'
+                         f'{100 * c["holdout_gain"]:7.0f}%{100 * c["explained_share"]:6.0f}%'
+                         f'{c["delta_bic"]:9.0f}{c["holdout_z"]:9.1f}  {status}')
+    for note in d.notes:
+        lines.append(f'note: {note}')
+    return '\n'.join(lines)
+
+
+def plot_diagnosis(d: Any, path: str | Path) -> Path:
+    """Figure: measured vs baseline vs augmented, residuals with the located regions, ACF.
+
+    Parameters
+    ----------
+    d : Diagnosis
+        The diagnosis to draw.
+    path : str or pathlib.Path
+        PNG file to write (a directory gets ``diagnosis_<channel>.png``).
+
+    Returns
+    -------
+    pathlib.Path
+        The file written.
+    """
+    import matplotlib
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+
+    path = Path(path)
+    if path.is_dir() or path.suffix == '':
+        path.mkdir(parents=True, exist_ok=True)
+        path = path / f'diagnosis_{d.channel}.png'
+    t, y, nt = d.t_s, d.measurement, d.n_train
+    base, fin = d.baseline.prediction, d.final.prediction
+    label = 'augmented: ' + ' + '.join(d.final.ids) if d.findings else 'augmented (none)'
+    what = 'simulator' if d.mode == 'sim' else 'baseline'
+    fig, ax = plt.subplots(2, 2, figsize=(13, 8), gridspec_kw={'width_ratios': [2.2, 1]})
+    a = ax[0, 0]
+    a.plot(t, y, '.', ms=1.5, color='0.3', label='measured')
+    a.plot(t, base, lw=1, color='tab:red', label=what)
+    if d.findings:
+        a.plot(t, fin, lw=1, color='tab:blue', label=label)
+    a.axvspan(t[nt], t[-1], color='0.9', zorder=0, label='held out')
+    a.set_ylabel(f'{d.channel} [{d.measurement_unit or "units"}]')
+    a.legend(loc='best', fontsize=8)
+    a.set_title(f'verdict: {d.verdict}')
+    a = ax[1, 0]
+    a.plot(t, y - base, lw=0.7, color='tab:red',
+           label=f'{what} residual (held-out %e_r {d.baseline.er_holdout_percent:.3g})')
+    if d.findings:
+        a.plot(t, y - fin, lw=0.7, color='tab:blue',
+               label=f'after (held-out %e_r {d.final.er_holdout_percent:.3g})')
+    for i, (t0, t1, _) in enumerate(d.localization.regions):
+        a.axvspan(t0, t1, color='orange', alpha=0.25, zorder=0,
+                  label='located windows' if i == 0 else None)
+    mask = d.localization.mask
+    if mask is not None and mask.any():
+        a.plot(t[mask], (y - base)[mask], '.', ms=1.5, color='orange',
+               label='located input regimes')
+    a.axvline(t[nt], color='k', lw=0.8, ls='--')
+    s = d.noise_std
+    a.axhspan(-2 * s, 2 * s, color='green', alpha=0.12, zorder=0, label='+-2 noise std')
+    a.set_xlabel('t [s]')
+    a.set_ylabel('residual')
+    a.legend(loc='best', fontsize=7)
+    a = ax[0, 1]
+    ho = slice(nt, None)
+    a.plot(d.command[ho], y[ho], '.', ms=1.5, color='0.3', label='measured (held out)')
+    a.plot(d.command[ho], base[ho], lw=0.7, color='tab:red', label=what)
+    if d.findings:
+        a.plot(d.command[ho], fin[ho], lw=0.7, color='tab:blue', label='augmented')
+    a.set_xlabel(f'command [{d.command_unit or "units"}]')
+    a.legend(loc='best', fontsize=7)
+    a.set_title('held-out loop')
+    a = ax[1, 1]
+    for loc, color, name in ((d.localization, 'tab:red', what),
+                             (d.final_localization, 'tab:blue', 'after')):
+        if loc is d.final_localization and not d.findings:
+            continue
+        a.plot(loc.acf['lags_s'], loc.acf['r'], color=color, lw=1, label=name)
+    b = d.localization.acf['bound']
+    a.axhspan(-b, b, color='green', alpha=0.15, label='99 % bound')
+    a.set_xlabel('lag [s]')
+    a.set_title('residual autocorrelation')
+    a.legend(loc='best', fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path

@@ -1,0 +1,182 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""What a diagnosis is asked to do and what it found (value objects).
+
+:class:`DiagnoseSettings`, :class:`Finding` (one accepted mechanism with its
+fitted block, words and held-out gain) and :class:`Diagnosis` (everything,
+with its JSON document, its ``/diagnostics`` status and its text report).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from hyst_id.diagnosis.locate import Localization
+from hyst_id.diagnosis.select import Criteria, FitResult
+from hyst_id.io.jsonable import jsonable
+
+__all__ = ['DiagnoseSettings', 'Diagnosis', 'Finding']
+
+
+@dataclass(frozen=True)
+class DiagnoseSettings:
+    """How to diagnose.
+
+    Attributes
+    ----------
+    train_fraction : float
+        Share of the record's duration used for fitting (the rest is held out).
+    seeds, generations, pop_size, workers :
+        GAASS settings of the baseline fit (fewer seeds than the paper; each
+        result is refined by least squares).
+    mechanisms : tuple of str or None
+        Mechanism ids to test (default: the whole library).
+    max_mechanisms : int
+        Most mechanisms added in sequence.
+    criteria : Criteria
+        Acceptance thresholds.
+    fit_budget : int
+        Residual evaluations for each local least-squares fit.
+    """
+
+    train_fraction: float = 0.7
+    seeds: tuple[int, ...] = (0, 1)
+    generations: int = 200
+    pop_size: int = 10
+    workers: int = 1
+    mechanisms: tuple[str, ...] | None = None
+    max_mechanisms: int = 2
+    criteria: Criteria = field(default_factory=Criteria)
+    fit_budget: int = 600
+
+
+@dataclass
+class Finding:
+    """One mechanism the data support, with its fitted block and what it bought."""
+
+    mechanism: str
+    title: str
+    placement: str
+    explanation: str
+    where: dict
+    params: dict
+    er_train_before_percent: float
+    er_train_after_percent: float
+    er_holdout_before_percent: float
+    er_holdout_after_percent: float
+    delta_bic: float
+    holdout_z: float
+    alternatives: list = field(default_factory=list)
+
+    def to_dict(self) -> dict:
+        """JSON-ready form."""
+        return {'mechanism': self.mechanism, 'title': self.title, 'placement': self.placement,
+                'explanation': self.explanation, 'where': jsonable(self.where),
+                'params': {k: q.to_dict() for k, q in self.params.items()},
+                'er_train_before_percent': self.er_train_before_percent,
+                'er_train_after_percent': self.er_train_after_percent,
+                'er_holdout_before_percent': self.er_holdout_before_percent,
+                'er_holdout_after_percent': self.er_holdout_after_percent,
+                'delta_bic': self.delta_bic, 'holdout_z': self.holdout_z,
+                'alternatives': list(self.alternatives)}
+
+
+@dataclass
+class Diagnosis:
+    """Everything a diagnosis found (see :meth:`to_dict` for the JSON layout)."""
+
+    channel: str
+    source: str
+    mode: str
+    verdict: str
+    t_s: np.ndarray
+    command: np.ndarray
+    measurement: np.ndarray
+    n_train: int
+    baseline: FitResult
+    final: FitResult
+    findings: list[Finding]
+    localization: Localization
+    final_localization: Localization
+    noise_std: float
+    noise_floor_percent: float
+    noise_floor_train_percent: float
+    rounds: list = field(default_factory=list)
+    baseline_params: dict = field(default_factory=dict)
+    measurement_unit: str = ''
+    command_unit: str = ''
+    notes: list = field(default_factory=list)
+    extra: dict = field(default_factory=dict)
+
+    @property
+    def train_fraction(self) -> float:
+        """Share of the duration used for training."""
+        t = self.t_s
+        return float((t[self.n_train - 1] - t[0]) / (t[-1] - t[0]))
+
+    def to_dict(self) -> dict:
+        """The ``--json`` document."""
+        t = self.t_s
+        out = {
+            'channel': self.channel, 'source': self.source, 'mode': self.mode,
+            'verdict': self.verdict,
+            'split': {'train_fraction': self.train_fraction, 'n_train': self.n_train,
+                      'n_holdout': int(t.size - self.n_train),
+                      't_split_s': float(t[self.n_train])},
+            'baseline': {'er_train_percent': self.baseline.er_train_percent,
+                         'er_holdout_percent': self.baseline.er_holdout_percent,
+                         'params': self.baseline_params},
+            'noise_floor_percent': self.noise_floor_percent,
+            'noise_floor_train_percent': self.noise_floor_train_percent,
+            'noise_std': self.noise_std, 'measurement_unit': self.measurement_unit,
+            'findings': [f.to_dict() for f in self.findings],
+            'final': {'mechanisms': list(self.final.ids),
+                      'er_train_percent': self.final.er_train_percent,
+                      'er_holdout_percent': self.final.er_holdout_percent},
+            'located': {'summary': self.localization.summary(self.measurement_unit),
+                        **self.localization.to_dict()},
+            'final_residual': {'summary': self.final_localization.summary(
+                self.measurement_unit), 'white': self.final_localization.white,
+                'independent': self.final_localization.independent},
+            'tested': self.rounds, 'notes': list(self.notes),
+        }
+        out.update(self.extra)
+        return jsonable(out)
+
+    def status(self) -> tuple[str, str, dict[str, str]]:
+        """Level (``ok``/``warn``), one-line message and string key-values, for diagnostics.
+
+        A ROS node can put these straight into a ``diagnostic_msgs/DiagnosticStatus``
+        (the core does not import ROS).
+        """
+        values = {'verdict': self.verdict, 'channel': self.channel,
+                  'baseline_er_holdout_percent': f'{self.baseline.er_holdout_percent:.4g}',
+                  'final_er_holdout_percent': f'{self.final.er_holdout_percent:.4g}',
+                  'noise_floor_percent': f'{self.noise_floor_percent:.4g}',
+                  'mechanisms': ','.join(f.mechanism for f in self.findings)}
+        for f in self.findings:
+            for name, q in f.params.items():
+                values[f'{f.mechanism}.{name}'] = f'{q.value:.4g} {q.unit}'.strip()
+        if not self.findings:
+            return 'ok', 'no missing physics found', values
+        f = self.findings[0]
+        return 'warn', f'{f.mechanism}: {f.explanation.split(". ")[0]}', values
+
+    def report(self) -> str:
+        """Plain-text report (see :mod:`hyst_id.diagnosis.report`)."""
+        from hyst_id.diagnosis.report import format_diagnosis
+        return format_diagnosis(self)

@@ -1,0 +1,87 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""Build a chain spec and identification settings from plain values (CLI, nodes, fleet).
+
+One place turns what a user gives (``--domains auto|paper|FILE``, seed
+counts, generations, ...) into a :class:`~hyst_id.identification.chains.ChainSpec`
+and :class:`~hyst_id.identification.result.IdentifySettings`, with one-line errors,
+so that ``hyst-id identify`` and the identifier node build them alike.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+from hyst_id.errors import ConfigError
+from hyst_id.identification.chains import ChainSpec
+from hyst_id.identification.domains import AUTO, domains_from_data, preset_spec, PRESETS
+from hyst_id.identification.result import IdentifySettings
+from hyst_id.io.params_file import read_yaml
+from hyst_id.io.recording import Recording
+
+__all__ = ['make_settings', 'make_spec', 'read_domains_file']
+
+
+def make_settings(*, seeds: int = 10, seed_offset: int = 0, pop_size: int = 10,
+                  generations: int = 500, c: float = 0.007, xi: float = 0.02,
+                  workers: int = 0, refine: bool = True, restarts: int = 4,
+                  er_bound_percent: float | None = None) -> IdentifySettings:
+    """GAASS and refinement settings (the paper's by default), checked.
+
+    Raises
+    ------
+    ConfigError
+        Fewer than one seed or generation, a population below two, negative restarts.
+    """
+    if seeds < 1 or pop_size < 2 or generations < 1 or restarts < 0:
+        raise ConfigError('need seeds >= 1, pop size >= 2, generations >= 1 and '
+                          'restarts >= 0')
+    return IdentifySettings(
+        pop_size=int(pop_size), maxiter=int(generations), c=float(c), xi=float(xi),
+        seeds=tuple(range(int(seed_offset), int(seed_offset) + int(seeds))),
+        workers=int(workers), refine=bool(refine), restarts=int(restarts),
+        er_bound_percent=er_bound_percent)
+
+
+def read_domains_file(path: str) -> dict[str, tuple[float, float]]:
+    """Search domains from a YAML file: ``name: [low, high]`` (optionally under ``domains:``)."""
+    data = read_yaml(path, 'domains file') or {}
+    data = data.get('domains', data) if isinstance(data, Mapping) else data
+    if not isinstance(data, Mapping):
+        raise ConfigError(f'domains file {path} must map parameter names to [low, high]')
+    try:
+        return {str(k): (float(v[0]), float(v[1])) for k, v in data.items()}
+    except (TypeError, ValueError, IndexError):
+        raise ConfigError(f'domains file {path}: each entry must be [low, high]') from None
+
+
+def make_spec(rec: Recording, domains: str | Mapping = AUTO) -> ChainSpec:
+    """Chain spec for a recording with the search domains asked for.
+
+    Parameters
+    ----------
+    rec : Recording
+        The recording to identify.
+    domains : str or mapping
+        ``'auto'`` (derived from the data), a preset name (``'paper'``), a
+        YAML file of overrides, or a mapping ``name -> (low, high)`` of overrides.
+    """
+    if isinstance(domains, Mapping):
+        return domains_from_data(rec, overrides=domains)
+    if domains == AUTO:
+        return domains_from_data(rec)
+    if domains in PRESETS:
+        return preset_spec(domains, rec.channel)
+    return domains_from_data(rec, overrides=read_domains_file(domains))

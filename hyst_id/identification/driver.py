@@ -1,0 +1,257 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""Identification of a chain from a recording: GAASS over seeds, refinement, noise floor.
+
+``identify(recording)`` runs GAASS once per seed (in parallel processes),
+optionally polishes each best chromosome with a bounded local least-squares
+fit (:mod:`hyst_id.identification.refine`), brings every result into the canonical gauge
+(:mod:`hyst_id.identification.gauge`) so seeds can be compared and averaged, and returns an
+:class:`Identification` holding all of it, the paper's %e_r (Eq. 7) and the
+noise floor.
+"""
+
+from __future__ import annotations
+
+from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
+import multiprocessing
+import os
+import threading
+from typing import Any, Callable
+
+import numpy as np
+from threadpoolctl import threadpool_limits
+
+from hyst_id.errors import IdentificationError, InvalidParametersError
+from hyst_id.identification.chains import chain_spec, ChainSpec, er_percent
+from hyst_id.identification.domains import domains_from_data
+from hyst_id.identification.gauge import canonical_gauge, output_sign
+from hyst_id.identification.quality import identification_warnings
+from hyst_id.identification.refine import refine
+from hyst_id.identification.result import Identification, IdentifySettings, SeedRun
+from hyst_id.io.recording import Recording, validate_recording
+from hyst_id.signals.noise import noise_floor_percent
+from hyst_id.solvers.gaass import GaassSolver
+
+__all__ = ['identify', 'run_seed', 'summarise']
+
+
+def run_seed(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray, measurement: np.ndarray,
+             settings: IdentifySettings, seed: int, floor_percent: float = 0.0,
+             on_generation: Callable[[int, int, int, float], Any] | None = None) -> SeedRun:
+    """Identify with one seed: GAASS, refinement, restarts; picklable for workers.
+
+    The first GAASS run uses ``seed`` itself (the paper's procedure). With
+    refinement on, the ``refine_top`` best distinct chromosomes of the final
+    population are polished and the best kept; while %e_r stays above
+    ``restart_factor`` times the noise floor, GAASS restarts with a seed
+    derived from ``(seed, restart)``, up to ``restarts`` times, or until
+    ``restart_patience`` restarts in a row gain less than 1 % while %e_r is
+    above 1.5 x the floor.
+    ``on_generation(seed, restart, generation, er_percent)`` is called after
+    every GAASS generation (it may raise to abandon the seed).
+    """
+    with threadpool_limits(limits=1):   # parallelism is over seeds, not inside BLAS
+        return _run_seed(spec, t_s, command, measurement, settings, seed, floor_percent,
+                         on_generation)
+
+
+def _run_seed(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray, measurement: np.ndarray,
+              settings: IdentifySettings, seed: int, floor_percent: float,
+              on_generation: Callable[[int, int, int, float], Any] | None) -> SeedRun:
+    cost = spec.cost_function(t_s, command, measurement)
+    sum_sq = float(np.sum(measurement ** 2))
+    target = None
+    if settings.er_bound_percent is not None:
+        target = (settings.er_bound_percent / 100.0) ** 2 * sum_sq
+    good_enough = (settings.restart_factor * floor_percent / 100.0) ** 2 * sum_sq
+    best_x, best_fun, er_ga, nfev, nit, history, message = None, np.inf, np.nan, 0, 0, None, ''
+    stalled = 0
+    for restart in range(1 + (settings.restarts if settings.refine else 0)):
+        rng = seed if restart == 0 else np.random.default_rng([seed, restart])
+        solver = GaassSolver(cost, spec.bounds, feasible=spec.feasible,
+                             pop_size=settings.pop_size, maxiter=settings.maxiter, c=settings.c,
+                             xi=settings.xi, target=target, rng=rng,
+                             callback=_report(on_generation, seed, restart, measurement))
+        res = solver.solve()
+        nfev += int(res.nfev)
+        nit += int(res.nit)
+        if restart == 0:
+            er_ga = float(er_percent(res.fun, measurement))
+            history, message = np.asarray(res.history.best_fun, dtype=float), str(res.message)
+        candidates = [(np.asarray(res.x, dtype=float), float(res.fun))]
+        if settings.refine:
+            candidates = []
+            for x0 in _distinct_best(res.population, res.population_fun, settings.refine_top):
+                x_ref, fun_ref, nfev_ref = refine(spec, x0, t_s, command, measurement,
+                                                  max_nfev=settings.refine_max_nfev)
+                nfev += nfev_ref
+                candidates.append((x_ref, fun_ref))
+        previous = best_fun
+        for x, fun in candidates:
+            if fun < best_fun:
+                best_x, best_fun = x, fun
+        if best_fun <= good_enough or (target is not None and best_fun <= target):
+            break
+        # far above the floor the model cannot reach it (unmodelled physics): stop once
+        # restarts stop gaining; near it a later restart often finds the exact basin
+        far = best_fun > (_STALL_FLOOR_FACTOR * floor_percent / 100.0) ** 2 * sum_sq
+        stalled = stalled + 1 if restart and far and best_fun > 0.99 * previous else 0
+        if stalled >= settings.restart_patience:
+            break
+    k, b = spec.fit_calibration(best_x, t_s, command, measurement)
+    if k == 0:
+        raise IdentificationError('the best chain output does not vary: the measurement '
+                                  'shows no response to the command')
+    x = canonical_gauge(best_x, (k, b))
+    return SeedRun(seed=int(seed), x_raw=best_x, x=x, sign=output_sign((k, b)),
+                   fun=float(best_fun),
+                   er_percent=float(er_percent(best_fun, measurement)), er_gaass_percent=er_ga,
+                   nfev=nfev, nit=nit, best_history=history, message=message)
+
+
+def _report(on_generation: Callable[[int, int, int, float], Any] | None, seed: int,
+            restart: int, measurement: np.ndarray) -> Callable[[Any], None] | None:
+    """GAASS callback that hands each generation to ``on_generation`` (None: none)."""
+    if on_generation is None:
+        return None
+
+    def callback(res: Any) -> None:
+        on_generation(seed, restart, int(res.nit), float(er_percent(res.fun, measurement)))
+    return callback
+
+
+def _distinct_best(pop: np.ndarray, fun: np.ndarray, count: int) -> list[np.ndarray]:
+    """The ``count`` best finite rows of a population, skipping duplicates."""
+    order = np.argsort(np.where(np.isfinite(fun), fun, np.inf))
+    chosen: list[np.ndarray] = []
+    for i in order:
+        if not np.isfinite(fun[i]):
+            break
+        if any(np.allclose(pop[i], c, rtol=1e-9, atol=1e-12) for c in chosen):
+            continue
+        chosen.append(np.asarray(pop[i], dtype=float))
+        if len(chosen) == count:
+            break
+    return chosen
+
+
+def _mp_context():
+    """Fork where it is safe (no other threads, POSIX), spawn otherwise.
+
+    Fork needs no ``if __name__ == '__main__'`` guard in user scripts and
+    reuses the compiled numba kernels; with threads running (a ROS
+    executor) only spawn is safe.
+    """
+    if 'fork' in multiprocessing.get_all_start_methods() and threading.active_count() == 1:
+        return multiprocessing.get_context('fork')
+    return multiprocessing.get_context('spawn')
+
+
+#: Restarts may stop for lack of gain only above this multiple of the noise floor.
+_STALL_FLOOR_FACTOR = 1.5
+
+
+def _n_workers(settings: IdentifySettings) -> int:
+    workers = settings.workers or (os.cpu_count() or 1)
+    return max(1, min(workers, len(settings.seeds)))
+
+
+def identify(recording: Recording, *, spec: ChainSpec | None = None,
+             settings: IdentifySettings | None = None,
+             progress: Callable[[int, int, SeedRun], None] | None = None,
+             on_generation: Callable[[int, int, int, float], Any] | None = None
+             ) -> Identification:
+    """Identify the chain of ``recording.channel`` from a recording.
+
+    Parameters
+    ----------
+    recording : Recording
+        The run to identify from (validated here).
+    spec : ChainSpec, optional
+        Chain spec with search domains; default derived from the recording
+        (:func:`hyst_id.identification.domains.domains_from_data`). The paper's domains are
+        ``hyst_id.identification.domains.preset_spec('paper', channel)``.
+    settings : IdentifySettings, optional
+        GAASS and refinement settings; default the paper's.
+    progress : callable, optional
+        Called as ``progress(done, total, seed_run)`` after each seed.
+    on_generation : callable, optional
+        Called as ``on_generation(seed, restart, generation, er_percent)``
+        after every GAASS generation, when the seeds run in this process
+        (``workers == 1``; worker processes report per seed only).
+
+    Returns
+    -------
+    Identification
+    """
+    rec = validate_recording(recording)
+    settings = settings or IdentifySettings()
+    spec = spec or domains_from_data(rec)
+    if spec.channel != rec.channel:
+        raise IdentificationError(
+            f'chain is for {spec.channel!r} but the recording is {rec.channel!r}')
+    if not settings.seeds:
+        raise IdentificationError('no seeds given')
+    floor = noise_floor_percent(rec.measurement)
+    args = (spec, rec.t_s, rec.command, rec.measurement, settings)
+    runs: list[SeedRun] = []
+    n_workers = _n_workers(settings)
+    if n_workers == 1:
+        for seed in settings.seeds:
+            runs.append(run_seed(*args, seed, floor, on_generation))
+            if progress:
+                progress(len(runs), len(settings.seeds), runs[-1])
+    else:
+        # Limit BLAS threads in the parent too: forked children inherit its pools.
+        with threadpool_limits(limits=1), ProcessPoolExecutor(
+                max_workers=n_workers, mp_context=_mp_context()) as pool:
+            futures = [pool.submit(run_seed, *args, seed, floor) for seed in settings.seeds]
+            try:
+                for fut in futures:
+                    runs.append(fut.result())
+                    if progress:
+                        progress(len(runs), len(settings.seeds), runs[-1])
+            except BrokenProcessPool as exc:
+                raise IdentificationError(f'a worker process died: {exc}') from None
+    ident = summarise(rec, spec, settings, runs)
+    ident.warnings += identification_warnings(ident, rec, spec)
+    return ident
+
+
+def summarise(rec: Recording, spec: ChainSpec, settings: IdentifySettings,
+              runs: list[SeedRun]) -> Identification:
+    """Combine seed runs into an :class:`Identification`."""
+    best = min(runs, key=lambda r: r.fun)
+    canon = chain_spec(rec.channel, calibration=(best.sign, 0.0))
+    warnings = []
+    same_sign = [r for r in runs if r.sign == best.sign]
+    if len(same_sign) < len(runs):
+        warnings.append(f'{len(runs) - len(same_sign)} seed(s) found the opposite sensor '
+                        'gain sign; they are left out of the mean')
+    xs = np.array([r.x for r in same_sign])
+    x_mean = xs.mean(axis=0)
+    try:
+        y_mean = canon.simulate(x_mean, rec.t_s, rec.command)
+        er_mean = float(er_percent(np.sum((rec.measurement - y_mean) ** 2), rec.measurement))
+    except InvalidParametersError:  # an average of feasible sets can be infeasible
+        er_mean = float('nan')
+    return Identification(
+        channel=rec.channel, names=spec.names, params=spec.as_dict(best.x),
+        params_mean=spec.as_dict(x_mean), output_sign=best.sign, er_percent=best.er_percent,
+        er_mean_params_percent=er_mean,
+        noise_floor_percent=noise_floor_percent(rec.measurement),
+        runs=runs, bounds=spec.bounds, domain_source=spec.domain_source,
+        settings=settings, warnings=warnings, source=rec.source)

@@ -1,0 +1,476 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""Warnings about an identification: what the data could not tell.
+
+:func:`identification_warnings` returns one-line sentences for
+``Identification.warnings`` (the report prints them):
+
+* **loop shape** -- in the sign identified (``output_sign``) the model's loop
+  runs counter-clockwise and its output never moves against the command
+  right after a reversal; a friction force against displacement does both.
+* **fit** -- the best %e_r well above the noise floor; seeds in other optima.
+* **domain edges** -- judged in the search space (raw ``x_raw`` against the
+  search bounds) and reported only when a short refinement with that one
+  domain widened lowers the cost: a gauge parameter, or one the cost does
+  not depend on, may rest on an edge harmlessly.
+* **unexcited lines** -- the identified loop's geometry against the commands
+  visited: a line that never sets the output (the top line on the paper's
+  rig, as in its Table 1) leaves its parameters undetermined; a near-vertical
+  left or right line leaves its slope undetermined.
+* **poorly determined parameters** -- spread over the seeds that reached the
+  best fit, and the standard error from the output's sensitivity and the
+  noise, both relative to the parameter's natural scale.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from hyst_id.errors import InvalidParametersError
+from hyst_id.identification.chains import chain_spec, ChainSpec
+from hyst_id.identification.domains import loop_orientation, reversal_response
+from hyst_id.identification.refine import refine
+from hyst_id.identification.result import Identification
+from hyst_id.models.tk import loop_corners, simulate_hysteresis
+from hyst_id.signals.noise import estimate_noise_std
+from hyst_id.signals.reversals import half_period_s
+from hyst_id.solvers.gaass import GaassSolver
+
+if TYPE_CHECKING:
+    from hyst_id.io.recording import Recording
+
+__all__ = [
+    'active_lines',
+    'domain_edge_warnings',
+    'fit_warnings',
+    'identification_warnings',
+    'orientation_warnings',
+    'parameter_scales',
+    'poorly_determined_warnings',
+    'unexcited_warnings',
+]
+
+#: %e_r over the noise floor above which the fit is called incomplete.
+FIT_FACTOR = 1.5
+#: Seeds within this factor of the best %e_r count as converged.
+CONVERGED_FACTOR = 1.1
+#: Relative spread or standard error above which a parameter is poorly determined.
+POOR_RELATIVE = 0.05
+#: A line followed over less than this fraction of the command span is barely excited.
+BARELY = 0.02
+#: Where a parameter counts as on its domain edge, in domain widths.
+EDGE_TOL = 1e-3
+#: Relative cost drop that makes a domain edge matter.
+EDGE_GAIN = 0.01
+
+#: Parameters each line of the loop determines.
+LINE_PARAMS = {'left': ('m_l', 'c_l'), 'right': ('m_r', 'c_r'), 'top': ('m_t', 'c_t'),
+               'bottom': ('m_b', 'c_b')}
+_PHYSICAL_ZERO = ('m_l', 'm_r', 'm_t', 'm_b', 'm_bl', 'tau_s', 'zeta', 'omega_n')
+
+
+def identification_warnings(ident: Identification, rec: Recording,
+                            spec: ChainSpec | None = None) -> list[str]:
+    """Every warning about an identification, as one-line sentences.
+
+    Parameters
+    ----------
+    ident : Identification
+        The result (``runs`` with ``x_raw`` and canonical ``x``).
+    rec : Recording
+        The recording it was identified from.
+    spec : ChainSpec, optional
+        The search spec (bounds, calibration); default a profiled spec with
+        ``ident.bounds``.
+
+    Returns
+    -------
+    list of str
+        Warnings, most fundamental first.
+    """
+    if spec is None:
+        spec = chain_spec(ident.channel).with_bounds(ident.bounds, source=ident.domain_source)
+    out = orientation_warnings(rec, _sign(ident))
+    out += fit_warnings(ident)
+    out += domain_edge_warnings(ident, rec, spec)
+    unexcited, names = unexcited_warnings(ident, rec)
+    out += unexcited
+    out += poorly_determined_warnings(ident, rec, skip=names)
+    return out
+
+
+def orientation_warnings(rec: Recording, sign: float = 1.0) -> list[str]:
+    """Warn about loop shapes the model cannot make, in the sign identified.
+
+    The model's loop runs counter-clockwise in ``sign * measurement`` and
+    its output never moves against the command right after a reversal.
+    """
+    y = sign * np.asarray(rec.measurement, dtype=float)
+    out = []
+    if sign < 0:
+        out.append('output sign -1: the measurement falls as the chain output rises, so the '
+                   'parameters describe -measurement (c_t, c_b and the output lines in '
+                   'negated measurement units)')
+    orientation = loop_orientation(rec.command, y)
+    if orientation > 0.005:
+        out.append(f'the loop runs clockwise (orientation {orientation:+.2f}): the model makes '
+                   'counter-clockwise loops only, so it can only approximate this one')
+    against = reversal_response(rec.command, y)
+    if against >= 0.5:
+        out.append(f'after {100 * against:.0f} % of the command reversals the response first '
+                   'moves against the command (a transition right after each reversal, as a '
+                   'friction force against displacement makes); the branches of the '
+                   'model are monotone and switch before the reversal, so it cannot follow these '
+                   'transitions')
+    return out
+
+
+def fit_warnings(ident: Identification) -> list[str]:
+    """Warn about a fit above the noise floor and about seeds in other optima."""
+    out = []
+    floor = ident.noise_floor_percent
+    if floor > 0 and ident.er_percent > FIT_FACTOR * floor:
+        out.append(f'the best %e_r is {ident.er_percent / floor:.1f} x the noise floor: the '
+                   'model misses part of the response (unmodelled dynamics, drift, a loop '
+                   'shape it cannot make); look at the residual plot')
+    er = np.array([r.er_percent for r in ident.runs])
+    off = int(np.sum(er > CONVERGED_FACTOR * er.min()))
+    if off:
+        out.append(f'{off} of {len(er)} seeds ended more than '
+                   f'{100 * (CONVERGED_FACTOR - 1):.0f} % above the best %e_r (other local '
+                   'optima): the best run is reported; the mean over seeds mixes optima')
+    return out
+
+
+def _at_edge(x: np.ndarray, bounds: np.ndarray) -> np.ndarray:
+    """-1 on the lower edge, +1 on the upper, 0 inside, per parameter."""
+    tol = EDGE_TOL * (bounds[:, 1] - bounds[:, 0])
+    return np.where(x <= bounds[:, 0] + tol, -1, np.where(x >= bounds[:, 1] - tol, 1, 0))
+
+
+def _probe(spec: ChainSpec, rec: Recording, x0: np.ndarray, generations: int,
+           max_nfev: int) -> float:
+    """Best cost of a short GAASS run seeded with ``x0``, then a refinement."""
+    cost = spec.cost_function(rec.t_s, rec.command, rec.measurement)
+    res = GaassSolver(cost, spec.bounds, feasible=spec.feasible, pop_size=10,
+                      maxiter=generations, x0=x0, rng=0).solve()
+    _, fun, _ = refine(spec, res.x, rec.t_s, rec.command, rec.measurement, max_nfev=max_nfev)
+    return min(float(res.fun), fun)
+
+
+def domain_edge_warnings(ident: Identification, rec: Recording, spec: ChainSpec, *,
+                         probe_generations: int = 50, probe_nfev: int = 1000) -> list[str]:
+    """Warn about parameters on a domain edge whose domain was too narrow.
+
+    Parameters
+    ----------
+    ident : Identification
+        The result; ``x_raw`` of each run is compared with ``spec.bounds``.
+    rec : Recording
+        The recording.
+    spec : ChainSpec
+        The search spec.
+    probe_generations, probe_nfev : int
+        Size of each probe: GAASS generations (population 10, seeded with
+        the best run) and refinement evaluations.
+
+    Returns
+    -------
+    list of str
+        One warning per parameter on an edge of the best run for which a
+        short search from the best run in the domain widened past that edge
+        ends more than 1 % lower than the same search in the original domain.
+    """
+    y = np.asarray(rec.measurement, dtype=float)
+    bounds = np.asarray(spec.bounds, dtype=float)
+    edges = np.array([_at_edge(r.x_raw, bounds) for r in ident.runs])
+    best = min(ident.runs, key=lambda r: r.fun)
+    best_edge = _at_edge(best.x_raw, bounds)
+    out, f_same = [], None
+    for i, name in enumerate(spec.names):
+        side = int(best_edge[i])
+        if side == 0 or (name == 'm_bl' and spec.profiled):
+            continue
+        if side < 0 and name in _PHYSICAL_ZERO and bounds[i, 0] <= 0.0:
+            continue            # a physical limit, not a chosen domain
+        width = bounds[i, 1] - bounds[i, 0]
+        wide = bounds.copy()
+        if side < 0:
+            wide[i, 0] -= width
+            if name in _PHYSICAL_ZERO:
+                wide[i, 0] = max(wide[i, 0], 0.0)
+        else:
+            wide[i, 1] += width
+        if f_same is None:
+            f_same = min(best.fun, _probe(spec, rec, best.x_raw, probe_generations, probe_nfev))
+        f_wide = _probe(spec.with_bounds(wide, source=spec.domain_source), rec, best.x_raw,
+                        probe_generations, probe_nfev)
+        if not f_wide < (1.0 - EDGE_GAIN) * f_same:
+            continue
+        er_now = 100.0 * np.sqrt(f_same / np.sum(y ** 2))
+        er_wide = 100.0 * np.sqrt(f_wide / np.sum(y ** 2))
+        n_edge = int(np.sum(edges[:, i] == side))
+        lo, hi = bounds[i]
+        out.append(f'{name} sits on the {"lower" if side < 0 else "upper"} edge of its search '
+                   f'domain [{lo:.4g}, {hi:.4g}] in {n_edge} of {len(ident.runs)} seeds, and '
+                   f'widening that domain lowers %e_r from {er_now:.3f} to {er_wide:.3f}: the '
+                   'domain is too narrow (give wider domains with --domains FILE.yaml)')
+    return out
+
+
+def _line_terms(params: np.ndarray, command: np.ndarray
+                ) -> tuple[np.ndarray, dict[str, np.ndarray], dict[str, np.ndarray]]:
+    """H's output, and per line the samples it sets and how much it moves the output there.
+
+    The *depth* of a line at a sample is how far the output would be from
+    its value if that line were absent (the right line lifts the output off
+    the inner rising line, the top line caps it, ...).
+    """
+    p = np.asarray(params, dtype=float)[:8]
+    m_l, m_r, m_t, m_b, c_l, c_r, c_t, c_b = p
+    v = np.asarray(command, dtype=float)
+    u = simulate_hysteresis(p, v)
+    vp, up, vj, uj = v[:-1], u[:-1], v[1:], u[1:]
+    tol = 1e-9 * (1.0 + np.abs(uj))
+    rise = vj > vp
+    fall = vj < vp
+    inner_up = m_b * vj + (up - m_b * vp)
+    right = m_r * (vj - c_r)
+    top = m_t * vj + c_t
+    inner_down = m_t * vj + (up - m_t * vp)
+    left = m_l * (vj - c_l)
+    bottom = m_b * vj + c_b
+    on_top = rise & (top <= np.maximum(inner_up, right) + tol)
+    on_right = rise & ~on_top & (right >= inner_up - tol)
+    on_bottom = fall & (bottom >= np.minimum(inner_down, left) - tol)
+    on_left = fall & ~on_bottom & (left <= inner_down + tol)
+    masks = {'left': on_left, 'right': on_right, 'top': on_top, 'bottom': on_bottom,
+             'rising': rise & ~on_top & ~on_right, 'falling': fall & ~on_bottom & ~on_left}
+    depth = {'top': np.where(on_top, np.maximum(inner_up, right) - top, 0.0),
+             'right': np.where(on_right, np.minimum(right, top) - inner_up, 0.0),
+             'bottom': np.where(on_bottom, bottom - np.minimum(inner_down, left), 0.0),
+             'left': np.where(on_left, inner_down - np.maximum(left, bottom), 0.0)}
+    pad = np.zeros(1, dtype=bool)
+    return (u, {k: np.concatenate([pad, m]) for k, m in masks.items()},
+            {k: np.concatenate([[0.0], d]) for k, d in depth.items()})
+
+
+def active_lines(params: np.ndarray, command: np.ndarray) -> dict[str, np.ndarray]:
+    """Which line of the loop sets H's output at each sample.
+
+    Parameters
+    ----------
+    params : numpy.ndarray
+        Hysteresis parameters (the first 8 of a chain vector).
+    command : numpy.ndarray
+        Command per sample.
+
+    Returns
+    -------
+    dict
+        Boolean masks ``left``, ``right``, ``top``, ``bottom``, ``rising``
+        (inner lines of slope ``m_b``) and ``falling`` (slope ``m_t``); the
+        first sample and samples where the command holds belong to none.
+    """
+    return _line_terms(params, command)[1]
+
+
+def unexcited_warnings(ident: Identification, rec: Recording) -> tuple[list[str], set[str]]:
+    """Warn about lines of the identified loop that the command never drives H along.
+
+    A line that H follows over less than 2 % of the command span, and that
+    moves the output off the other lines by less than 2 % of the output span
+    (a top line touched only at its corner), leaves its parameters
+    undetermined; a left or right line that moves the output over a short
+    stretch of command is a jump whose slope is undetermined.
+
+    Returns
+    -------
+    warnings : list of str
+        One per line never (or barely) followed, or steeper than resolved.
+    names : set of str
+        Parameters left undetermined by those lines.
+    """
+    v = np.asarray(rec.command, dtype=float)
+    span = float(np.ptp(v))
+    x = np.asarray(ident.x, dtype=float)
+    try:
+        u, masks, depth = _line_terms(x, v)
+        corners = loop_corners(x[:8])
+    except InvalidParametersError:
+        return [], set()
+    unit = f' {rec.command_unit}' if rec.command_unit else ''
+    where = {
+        'top': ('rises', 'above', corners['C'][0], 'top-right corner'),
+        'bottom': ('falls', 'below', corners['A'][0], 'bottom-left corner'),
+        'right': ('rises', 'above', corners['B'][0], 'bottom-right corner'),
+        'left': ('falls', 'below', corners['D'][0], 'top-left corner'),
+    }
+    inner = {'top': 'falling', 'bottom': 'rising'}
+    span_u = float(np.ptp(u)) or 1.0
+    out, names = [], set()
+    for line, (verb, side, v_corner, corner) in where.items():
+        mask = masks[line]
+        travel_v = float(np.ptp(v[mask])) / span if mask.sum() >= 2 else 0.0
+        travel_u = float(np.ptp(u[mask])) / span_u if mask.sum() >= 2 else 0.0
+        reach = float(np.max(depth[line])) / span_u
+        if travel_v < BARELY <= max(travel_u, reach) and line in ('left', 'right'):
+            slope = LINE_PARAMS[line][0]
+            names.add(slope)
+            out.append(f'the {line} line of the loop is steeper than the recording '
+                       f'resolves (the output crosses {100 * max(travel_u, reach):.0f} % of '
+                       f'its span within {100 * travel_v:.1f} % of the command span): {slope} '
+                       f'only says "a jump", {LINE_PARAMS[line][1]} places it')
+        if max(travel_v, travel_u, reach) >= BARELY:
+            continue
+        undetermined = list(LINE_PARAMS[line])
+        if line in inner and masks[inner[line]].sum() >= 3:
+            undetermined = undetermined[1:]      # the slope still shows on inner lines
+        names.update(undetermined)
+        extreme = float(v.max() if verb == 'rises' else v.min())
+        what = (f'{" and ".join(undetermined)} '
+                f'{"is" if len(undetermined) == 1 else "are"} not identifiable from this '
+                'recording')
+        short = (extreme < v_corner) if verb == 'rises' else (extreme > v_corner)
+        if short:
+            out.append(f'the {line} line of the loop is never reached: the command {verb} '
+                       f'to {extreme:.4g}{unit} but the {corner} of the loop is at '
+                       f'{v_corner:.4g}{unit}; {what} (drive the command {side} '
+                       f'{v_corner:.4g}{unit} to identify it)')
+        else:
+            out.append(f'the {line} line of the loop barely matters here (it sets the output '
+                       f'over less than {100 * BARELY:.0f} % of the command span and moves it '
+                       f'by less than {100 * BARELY:.0f} % of its span); {what}')
+    return out, names
+
+
+def parameter_scales(ident: Identification, rec: Recording) -> dict[str, float]:
+    """Natural scale of each canonical parameter, for relative spreads.
+
+    Slopes: the loop's mean slope (output span over command span). ``c_l``,
+    ``c_r``: the command span plus the lever of crossing at zero output far
+    from the data. ``c_t``, ``c_b``: the output span plus the lever of an
+    intercept at zero command. Backlash: the output span. ``tau_s``: the
+    excitation's half period; ``zeta``: 1; ``omega_n``: its value.
+    """
+    sign = _sign(ident)
+    v = np.asarray(rec.command, dtype=float)
+    y = sign * np.asarray(rec.measurement, dtype=float)
+    span_v, span_y = float(np.ptp(v)), float(np.ptp(y))
+    slope = span_y / span_v
+    v_mid, y_mid = 0.5 * (v.max() + v.min()), 0.5 * (y.max() + y.min())
+    scales = {'m_l': slope, 'm_r': slope, 'm_t': slope, 'm_b': slope,
+              'c_l': span_v + abs(y_mid) / slope, 'c_r': span_v + abs(y_mid) / slope,
+              'c_t': span_y + abs(v_mid) * slope, 'c_b': span_y + abs(v_mid) * slope,
+              'c_bl': span_y, 'c_br': span_y, 'tau_s': half_period_s(rec.t_s, rec.command),
+              'zeta': 1.0}
+    if 'omega_n' in ident.names:
+        scales['omega_n'] = max(abs(ident.params['omega_n']), 1e-12)
+    return {n: scales[n] for n in ident.names if n in scales}
+
+
+def _standard_errors(ident: Identification, rec: Recording, sign: float) -> dict[str, float]:
+    """Estimate standard errors from the output sensitivity at the best canonical parameters.
+
+    Canonical parameters free: H (8), the backlash half width (``c_br = -c_bl``),
+    sensor parameters. Covariance ``sigma^2 (J^T J)^+``.
+    """
+    spec = chain_spec(ident.channel, calibration=(1.0, 0.0))
+    x0 = np.asarray(ident.x, dtype=float)
+    free = [i for i, n in enumerate(ident.names) if n not in ('m_bl', 'c_bl')]
+    y = sign * np.asarray(rec.measurement, dtype=float)
+    sigma = estimate_noise_std(y)
+    scales = parameter_scales(ident, rec)
+
+    def output(x: np.ndarray) -> np.ndarray | None:
+        x = x.copy()
+        x[ident.names.index('c_bl')] = -x[ident.names.index('c_br')]
+        try:
+            return spec.simulate(x, rec.t_s, rec.command)
+        except InvalidParametersError:
+            return None
+
+    base = output(x0)
+    if base is None or sigma <= 0:
+        return {}
+    cols = []
+    for i in free:
+        h = 1e-4 * scales[ident.names[i]]
+        step = np.zeros_like(x0)
+        step[i] = h
+        hi, lo = output(x0 + step), output(x0 - step)
+        if hi is not None and lo is not None:
+            cols.append((hi - lo) / (2 * h))
+        elif hi is not None:
+            cols.append((hi - base) / h)
+        elif lo is not None:
+            cols.append((base - lo) / h)
+        else:
+            cols.append(np.zeros_like(base))
+    jac = np.array(cols).T
+    cov = sigma ** 2 * np.linalg.pinv(jac.T @ jac)
+    se = np.sqrt(np.maximum(np.diag(cov), 0.0))
+    zero = ~np.any(jac != 0.0, axis=0)
+    return {ident.names[i]: (np.inf if zero[k] else float(se[k])) for k, i in enumerate(free)}
+
+
+def poorly_determined_warnings(ident: Identification, rec: Recording,
+                               skip: set[str] | frozenset = frozenset()) -> list[str]:
+    """Warn about parameters the data pins down poorly.
+
+    A parameter is poorly determined when its spread (standard deviation)
+    over the converged seeds (``%e_r`` within 10 % of the best; at least 3)
+    or its standard error from the output sensitivity exceeds 5 % of its
+    scale (:func:`parameter_scales`). Parameters in ``skip`` (already
+    reported as unexcited) and the gauge-fixed backlash are left out.
+    """
+    sign = _sign(ident)
+    scales = parameter_scales(ident, rec)
+    er = np.array([r.er_percent for r in ident.runs])
+    good = [r for r, e in zip(ident.runs, er) if e <= CONVERGED_FACTOR * er.min()]
+    spread = {}
+    if len(good) >= 3:
+        xs = np.array([r.x for r in good])
+        spread = dict(zip(ident.names, xs.std(axis=0)))
+    errors = _standard_errors(ident, rec, sign)
+    found = []
+    for name, scale in scales.items():
+        if name in skip or name == 'c_bl':
+            continue
+        rel_spread = spread.get(name, 0.0) / scale
+        rel_error = errors.get(name, 0.0) / scale
+        if rel_spread > POOR_RELATIVE or rel_error > POOR_RELATIVE:
+            parts = []
+            if name in spread:
+                parts.append(f'spread over {len(good)} converged seeds '
+                             f'{_percent(rel_spread)}')
+            if name in errors:
+                parts.append(f'standard error {_percent(rel_error)}')
+            found.append(f'{name} ({", ".join(parts)} of its scale {scale:.3g})')
+    if not found:
+        return []
+    return ['poorly determined by this recording: ' + '; '.join(found)
+            + ' -- treat these values with care (a longer or wider excitation helps)']
+
+
+def _sign(ident: Identification) -> float:
+    """Canonical calibration sign: the canonical chain predicts ``sign * measurement``."""
+    return float(getattr(ident, 'output_sign', 1.0))
+
+
+def _percent(fraction: float) -> str:
+    return 'unbounded' if not np.isfinite(fraction) else f'{100 * fraction:.0f} %'

@@ -1,0 +1,146 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""Reports of an identification: Table 1 style text, JSON, figures.
+
+Plots use matplotlib's Agg backend (no display needed).
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from hyst_id.identification import Identification
+from hyst_id.identification.chains import er_percent, PARAM_UNITS
+from hyst_id.io.recording import Recording
+
+__all__ = ['format_table', 'write_json', 'plot_identification', 'er_of']
+
+
+def format_table(ident: Identification, truth: dict | None = None) -> str:
+    """Table 1 of the paper for one channel: mean over seeds, best run, spread.
+
+    Parameters
+    ----------
+    ident : Identification
+        The result.
+    truth : dict, optional
+        Known true (canonical) parameters, shown in an extra column.
+    """
+    xs = np.array([r.x for r in ident.runs])
+    spread = xs.std(axis=0)
+    head = f'{"param":8s} {"unit":8s} {"mean":>11s} {"best":>11s} {"std":>9s}'
+    if truth:
+        head += f' {"true":>11s}'
+    lines = [f'channel: {ident.channel}   seeds: {len(ident.runs)}   '
+             f'domains: {ident.domain_source}', head, '-' * len(head)]
+    for i, name in enumerate(ident.names):
+        row = (f'{name:8s} {PARAM_UNITS[name]:8s} {ident.params_mean[name]:11.4f} '
+               f'{ident.params[name]:11.4f} {spread[i]:9.4f}')
+        if truth:
+            row += f' {truth.get(name, float("nan")):11.4f}'
+        lines.append(row)
+    er = np.array([r.er_percent for r in ident.runs])
+    floor = ident.noise_floor_percent
+    lines += [
+        '-' * len(head),
+        f'%e_r best run        {ident.er_percent:8.3f}   '
+        f'({ident.er_percent / floor:.2f} x noise floor)' if floor > 0 else
+        f'%e_r best run        {ident.er_percent:8.3f}',
+        f'%e_r mean params     {ident.er_mean_params_percent:8.3f}',
+        f'%e_r over seeds      median {np.median(er):.3f}  worst {er.max():.3f}',
+        f'noise floor %e_r     {floor:8.3f}',
+    ]
+    lines += [f'warning: {w}' for w in ident.warnings]
+    return '\n'.join(lines)
+
+
+def write_json(ident: Identification, path: str | Path, extra: dict | None = None) -> None:
+    """Write the identification (and any extra fields) as JSON."""
+    data = ident.to_dict()
+    if extra:
+        data.update(extra)
+    Path(path).write_text(json.dumps(data, indent=2, default=_jsonable) + '\n')
+
+
+def _jsonable(obj):
+    if isinstance(obj, np.generic):
+        return obj.item()
+    if isinstance(obj, np.ndarray):
+        return obj.tolist()
+    raise TypeError(f'not JSON serialisable: {type(obj).__name__}')
+
+
+def plot_identification(ident: Identification, rec: Recording, out_dir: str | Path,
+                        stem: str = 'identify') -> list[Path]:
+    """Write loop, time-series/residual and convergence figures; return their paths."""
+    import matplotlib
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    y_fit = ident.spec().simulate(ident.x, rec.t_s, rec.command)
+    unit_c = f' [{rec.command_unit}]' if rec.command_unit else ''
+    unit_y = f' [{rec.measurement_unit}]' if rec.measurement_unit else ''
+    paths = []
+
+    fig, ax = plt.subplots(figsize=(6, 5))
+    ax.plot(rec.command, rec.measurement, '.', ms=2, alpha=0.5, label='measured')
+    ax.plot(rec.command, y_fit, '-', lw=1, label='identified chain')
+    ax.set_xlabel(f'command{unit_c}')
+    ax.set_ylabel(f'{rec.channel}{unit_y}')
+    ax.set_title(f'Hysteresis loop, {rec.channel}: %e_r {ident.er_percent:.2f}')
+    ax.legend()
+    paths.append(_save(fig, out / f'{stem}_loop.png'))
+
+    fig, (a1, a2) = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
+    a1.plot(rec.t_s, rec.measurement, lw=0.8, label='measured')
+    a1.plot(rec.t_s, y_fit, lw=0.8, label='identified')
+    a1.set_ylabel(f'{rec.channel}{unit_y}')
+    a1.legend()
+    a2.plot(rec.t_s, rec.measurement - y_fit, lw=0.6, color='C3')
+    a2.set_ylabel('residual')
+    a2.set_xlabel('time [s]')
+    paths.append(_save(fig, out / f'{stem}_residual.png'))
+
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    ss = float(np.sum(rec.measurement ** 2))
+    for run in ident.runs:
+        ax.semilogy(np.sqrt(np.asarray(run.best_history) / ss) * 100.0, lw=0.8,
+                    label=f'seed {run.seed}')
+    ax.axhline(ident.noise_floor_percent, color='k', ls='--', lw=0.8, label='noise floor')
+    ax.set_xlabel('generation')
+    ax.set_ylabel('best %e_r (GAASS)')
+    ax.set_title('GAASS convergence')
+    ax.legend(fontsize=6, ncol=2)
+    paths.append(_save(fig, out / f'{stem}_convergence.png'))
+    return paths
+
+
+def _save(fig, path: Path) -> Path:
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    import matplotlib.pyplot as plt
+    plt.close(fig)
+    return path
+
+
+def er_of(ident: Identification, rec: Recording) -> float:
+    """%e_r of the identification's best parameters on another recording."""
+    y = ident.spec().simulate(ident.x, rec.t_s, rec.command)
+    return float(er_percent(np.sum((rec.measurement - y) ** 2), rec.measurement))

@@ -1,0 +1,181 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""What an identification is asked to do and what it returns (plain value objects).
+
+:class:`IdentifySettings` (GAASS and refinement settings, the paper's by
+default), :class:`SeedRun` (one seed's result) and :class:`Identification`
+(everything :func:`hyst_id.identification.identify` produced). No computation
+here beyond building the JSON form and the chain spec of the result.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+from hyst_id.identification.chains import chain_spec, ChainSpec
+
+__all__ = ['IdentifySettings', 'SeedRun', 'Identification']
+
+
+@dataclass(frozen=True)
+class IdentifySettings:
+    """How to identify; defaults are the paper's GAASS settings plus refinement.
+
+    Attributes
+    ----------
+    pop_size, maxiter, c, xi :
+        GAASS population size, generations, contraction rate (Eq. 15) and
+        mutation subspace coefficient (Eq. 22).
+    seeds : tuple of int
+        One GAASS run per seed; results are averaged like the paper's Table 1.
+    workers : int
+        Parallel processes (0: one per core, at most one per seed).
+    refine : bool
+        Polish each GAASS result with bounded least squares (GAASS-only when False).
+    refine_max_nfev : int
+        Cost evaluations allowed to each refinement.
+    refine_top : int
+        How many of the best distinct chromosomes of a GAASS run are refined.
+    restarts : int
+        Extra GAASS runs (new derived seeds) while %e_r is above
+        ``restart_factor`` times the estimated noise floor (refinement on only).
+    restart_factor : float
+        Restarts stop once %e_r is within this factor of the noise floor.
+    restart_patience : int
+        Restarts also stop after this many in a row that lower the cost by
+        less than 1 % while %e_r is above 1.5 x the noise floor (the floor is
+        out of the model's reach: real data with unmodelled physics would
+        otherwise always pay for every restart).
+    er_bound_percent : float or None
+        Stop a GAASS run early once %e_r falls below this bound.
+    """
+
+    pop_size: int = 10
+    maxiter: int = 500
+    c: float = 0.007
+    xi: float = 0.02
+    seeds: tuple[int, ...] = tuple(range(10))
+    workers: int = 0
+    refine: bool = True
+    refine_max_nfev: int = 2000
+    refine_top: int = 3
+    restarts: int = 4
+    restart_factor: float = 1.05
+    restart_patience: int = 2
+    er_bound_percent: float | None = None
+
+
+@dataclass
+class SeedRun:
+    """Result of one seed: GAASS, then (optionally) refinement, raw and canonical.
+
+    ``sign`` is the canonical calibration gain (+1, or -1 for a sensor that
+    falls as the actuator output rises): measurement = ``sign * chain(x)``.
+    """
+
+    seed: int
+    x_raw: np.ndarray
+    x: np.ndarray
+    sign: float
+    fun: float
+    er_percent: float
+    er_gaass_percent: float
+    nfev: int
+    nit: int
+    best_history: np.ndarray
+    message: str
+
+
+@dataclass
+class Identification:
+    """Everything an identification produced.
+
+    Attributes
+    ----------
+    channel : str
+        Channel of the chain.
+    names : tuple of str
+        Parameter names.
+    params : dict
+        Best run's parameters in the canonical gauge (output in measurement units).
+    params_mean : dict
+        Canonical parameters averaged over seeds (the paper's Table 1 convention).
+    output_sign : float
+        +1, or -1 when the measurement falls as the actuator output rises;
+        the canonical chain predicts ``output_sign * measurement``.
+    er_percent : float
+        %e_r of the best run.
+    er_mean_params_percent : float
+        %e_r of the averaged parameters.
+    noise_floor_percent : float
+        %e_r that the estimated measurement noise alone gives.
+    runs : list of SeedRun
+        Per-seed results.
+    bounds : numpy.ndarray
+        Search domains used.
+    """
+
+    channel: str
+    names: tuple[str, ...]
+    params: dict
+    params_mean: dict
+    output_sign: float
+    er_percent: float
+    er_mean_params_percent: float
+    noise_floor_percent: float
+    runs: list[SeedRun]
+    bounds: np.ndarray
+    domain_source: str
+    settings: IdentifySettings
+    warnings: list[str] = field(default_factory=list)
+    source: str = ''
+
+    @property
+    def x(self) -> np.ndarray:
+        """Best canonical parameter vector."""
+        return np.array([self.params[n] for n in self.names])
+
+    def spec(self) -> ChainSpec:
+        """Chain spec that simulates the canonical parameters (calibration sign, 0)."""
+        return chain_spec(self.channel, calibration=(self.output_sign, 0.0)).with_bounds(
+            self.bounds, source=self.domain_source)
+
+    def to_dict(self) -> dict:
+        """JSON-ready summary (arrays as lists)."""
+        runs = []
+        for r in self.runs:
+            runs.append({'seed': r.seed, 'params': dict(zip(self.names, r.x.tolist())),
+                         'er_percent': r.er_percent, 'er_gaass_percent': r.er_gaass_percent,
+                         'nfev': r.nfev, 'nit': r.nit, 'message': r.message})
+        return {
+            'channel': self.channel, 'source': self.source,
+            'params': self.params, 'params_mean': self.params_mean,
+            'output_sign': self.output_sign,
+            'calibration': {'k': self.output_sign, 'b': 0.0,
+                            'note': 'canonical gauge: H output in measurement units '
+                            '(negated when output_sign is -1), backlash unit slope '
+                            'centred on 0'},
+            'er_percent': self.er_percent,
+            'er_mean_params_percent': self.er_mean_params_percent,
+            'er_seeds_percent': [r.er_percent for r in self.runs],
+            'noise_floor_percent': self.noise_floor_percent,
+            'domains': {n: list(map(float, b)) for n, b in zip(self.names, self.bounds)},
+            'domain_source': self.domain_source,
+            'settings': {k: (list(v) if isinstance(v, tuple) else v)
+                         for k, v in asdict(self.settings).items()},
+            'warnings': list(self.warnings), 'runs': runs,
+        }

@@ -1,0 +1,151 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""Read a :class:`~hyst_id.io.recording.Recording` from a delimited text file (CSV, TSV).
+
+Files are taken as they are: duplicate or decreasing timestamps are
+reported by validation, never repaired.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+import math
+from pathlib import Path
+
+import numpy as np
+
+from hyst_id.errors import ConfigError, MissingTopicError, RecordingError
+from hyst_id.io.recording import Recording
+
+__all__ = ['CSV_SUFFIXES', 'DEFAULT_COLUMNS', 'read_csv']
+
+#: File suffixes read as delimited text.
+CSV_SUFFIXES = ('.csv', '.txt', '.tsv')
+#: Header names read by default: time in seconds, command, measurement.
+DEFAULT_COLUMNS = ('t', 'command', 'measurement')
+
+
+def _is_number(cell: str) -> bool:
+    try:
+        float(cell)
+    except ValueError:
+        return False
+    return True
+
+
+def read_csv(path: str | Path, channel: str, *,
+             columns: Sequence[str | int] = DEFAULT_COLUMNS, time_scale: float = 1.0,
+             delimiter: str | None = None, command_unit: str = '',
+             measurement_unit: str = '') -> Recording:
+    """Read a recording from delimited text, without validating or reordering it.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The file. Blank lines and lines starting with ``#`` are skipped; the
+        first other line is a header if any of its cells is not a number.
+    channel : str
+        Measured channel stored in the recording.
+    columns : sequence of str or int
+        Time, command and measurement columns: header names, or 0-based
+        indices (needed for headerless files).
+    time_scale : float
+        Factor turning the time column into seconds (0.001 for ms).
+    delimiter : str, optional
+        Cell separator; default comma if the first line has one, else
+        semicolon if it has one, else runs of whitespace.
+    command_unit, measurement_unit : str
+        Units for reports.
+
+    Returns
+    -------
+    Recording
+        Not validated: :func:`read_recording` validates.
+
+    Raises
+    ------
+    RecordingError
+        Empty file, non-numeric cell, ragged rows.
+    MissingTopicError
+        A column is missing (or there is no header to look names up in).
+    ConfigError
+        Bad ``columns`` or ``time_scale``.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise RecordingError(f'no such file: {path}')
+    columns = tuple(columns)
+    if len(columns) != 3:
+        raise ConfigError(f'columns must name 3 columns (time, command, measurement), '
+                          f'got {columns!r}')
+    if not (isinstance(time_scale, (int, float)) and math.isfinite(time_scale)
+            and time_scale > 0):
+        raise ConfigError(f'time_scale must be a positive number, got {time_scale!r}')
+    try:
+        text = path.read_text(encoding='utf-8-sig')
+    except (OSError, UnicodeDecodeError) as exc:
+        raise RecordingError(f'cannot read {path}: {exc}') from None
+    lines = [(n, line) for n, line in enumerate(text.splitlines(), 1)
+             if line.strip() and not line.lstrip().startswith('#')]
+    if not lines:
+        raise RecordingError(f'empty file: {path}')
+    sep = delimiter
+    if sep is None:
+        sep = ',' if ',' in lines[0][1] else ';' if ';' in lines[0][1] else None
+
+    def split(line: str) -> list[str]:
+        return [c.strip().strip('"\'') for c in (line.split(sep) if sep else line.split())]
+
+    first = split(lines[0][1])
+    names = first if not all(_is_number(c) for c in first) else None
+    rows = lines[1:] if names is not None else lines
+    if not rows:
+        raise RecordingError(f'no data rows in {path}: only a header')
+    ncols = len(first)
+    index = []
+    for role, col in zip(('time', 'command', 'measurement'), columns, strict=True):
+        if isinstance(col, (int, np.integer)) and not isinstance(col, bool):
+            if not 0 <= int(col) < ncols:
+                raise MissingTopicError(f'{role} column index {col} out of range: {path} has '
+                                        f'{ncols} columns (0..{ncols - 1})')
+            index.append(int(col))
+        elif isinstance(col, str):
+            if names is None:
+                raise MissingTopicError(f'column {col!r} not found: {path} has no header row '
+                                        f'(pass integer column indices)')
+            if col not in names:
+                raise MissingTopicError(f'column {col!r} not in {path}; columns present: '
+                                        f'{", ".join(names)}')
+            index.append(names.index(col))
+        else:
+            raise ConfigError(f'column {col!r} must be a header name or an integer index')
+    labels = [names[i] if names else f'#{i}' for i in index]
+    data = np.empty((len(rows), 3))
+    for r, (lineno, line) in enumerate(rows):
+        cells = split(line)
+        if len(cells) != ncols:
+            raise RecordingError(f'ragged rows in {path}: line {lineno} has {len(cells)} '
+                                 f'fields, expected {ncols}')
+        for j, i in enumerate(index):
+            try:
+                data[r, j] = float(cells[i])
+            except ValueError:
+                raise RecordingError(f'non-numeric value {cells[i]!r} in column {labels[j]} '
+                                     f'at line {lineno} of {path}') from None
+    note = (f'columns: t_s = {labels[0]} x {time_scale:g}, command = {labels[1]}, '
+            f'measurement = {labels[2]}')
+    return Recording(t_s=data[:, 0] * float(time_scale), command=data[:, 1],
+                     measurement=data[:, 2], channel=channel, command_unit=command_unit,
+                     measurement_unit=measurement_unit, source=str(path), notes=(note,))

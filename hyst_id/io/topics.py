@@ -1,0 +1,203 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""Which topics, message types and fields hold a channel, and how to read a field path.
+
+:class:`TopicConfig` (defaults in ``params/topics.yaml``, overridable per
+channel), :func:`parse_field_path` / :func:`get_field` for paths such as
+``position[0]`` or ``header.stamp.sec``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, fields
+from pathlib import Path
+import re
+from typing import Any
+
+from hyst_id.errors import ConfigError
+from hyst_id.io.params_file import read_yaml
+from hyst_id.io.recording import CHANNELS
+
+__all__ = ['TopicConfig', 'get_field', 'load_topic_config', 'parse_field_path']
+
+#: Per channel: topic, message type, field path, unit.
+_COMMAND_DEFAULTS = ('/hyst_id/command', 'std_msgs/msg/Float64', 'data', 'mA')
+_CHANNEL_DEFAULTS = {
+    'position': ('/hyst_id/position', 'sensor_msgs/msg/JointState', 'position[0]', ''),
+    'pressure': ('/hyst_id/pressure', 'sensor_msgs/msg/FluidPressure', 'fluid_pressure', 'Pa'),
+    'flow': ('/hyst_id/flow', 'std_msgs/msg/Float64', 'data', 'g/s'),
+}
+_SUFFIXES = ('topic', 'type', 'field', 'unit')
+_KEYS = frozenset([f'command_{s}' for s in _SUFFIXES] + ['stamp_source']
+                  + [f'{ch}_{s}' for ch in CHANNELS for s in _SUFFIXES])
+_FIELD_RE = re.compile(r'[A-Za-z_]\w*(\[\d+\])*(\.[A-Za-z_]\w*(\[\d+\])*)*')
+
+
+def parse_field_path(path: str) -> tuple[str | int, ...]:
+    """Split a field path such as ``'position[0]'`` or ``'a.b[2].c'`` into tokens.
+
+    Raises
+    ------
+    ConfigError
+        The path is not dotted attribute names with optional ``[i]`` indices.
+    """
+    if not isinstance(path, str) or not _FIELD_RE.fullmatch(path):
+        raise ConfigError(f'bad field path {path!r}: expected names with optional [i] indices, '
+                          f'e.g. position[0] or header.stamp.sec')
+    return tuple(int(tok[1:-1]) if tok.startswith('[') else tok
+                 for tok in re.findall(r'\[\d+\]|[A-Za-z_]\w*', path))
+
+
+def get_field(msg: Any, tokens: Sequence[str | int]) -> Any:
+    """Follow parsed field-path ``tokens`` into a message (AttributeError/IndexError if absent)."""
+    value = msg
+    for tok in tokens:
+        value = value[tok] if isinstance(tok, int) else getattr(value, tok)
+    return value
+
+
+@dataclass(frozen=True)
+class TopicConfig:
+    """Where a recording's command and measurement live in a bag.
+
+    Attributes
+    ----------
+    command_topic, measurement_topic : str
+        Topic names.
+    command_field, measurement_field : str
+        Field paths in the messages (``data``, ``position[0]``, ...).
+    command_type, measurement_type : str
+        Message types written by :func:`~hyst_id.io.bag.write_recording_bag`
+        and expected when reading (another type is accepted, with a note, if
+        the field resolves to a number).
+    command_unit, measurement_unit : str
+        Units for reports.
+    stamp_source : str
+        ``'header'``: ``header.stamp`` when the message has a header, else
+        the log time; ``'log'``: always the log (receive) time.
+    """
+
+    command_topic: str = _COMMAND_DEFAULTS[0]
+    command_field: str = _COMMAND_DEFAULTS[2]
+    measurement_topic: str = _CHANNEL_DEFAULTS['position'][0]
+    measurement_field: str = _CHANNEL_DEFAULTS['position'][2]
+    command_type: str = _COMMAND_DEFAULTS[1]
+    measurement_type: str = _CHANNEL_DEFAULTS['position'][1]
+    command_unit: str = _COMMAND_DEFAULTS[3]
+    measurement_unit: str = _CHANNEL_DEFAULTS['position'][3]
+    stamp_source: str = 'header'
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            if not isinstance(getattr(self, f.name), str):
+                raise ConfigError(f'{f.name} must be a string, got {getattr(self, f.name)!r}')
+        for name in ('command_topic', 'measurement_topic', 'command_type', 'measurement_type'):
+            if not getattr(self, name).strip():
+                raise ConfigError(f'{name} is empty')
+        if self.command_topic == self.measurement_topic:
+            raise ConfigError(f'command and measurement share the topic {self.command_topic}')
+        parse_field_path(self.command_field)
+        parse_field_path(self.measurement_field)
+        if self.stamp_source not in ('header', 'log'):
+            raise ConfigError(f"stamp_source must be 'header' or 'log', got "
+                              f'{self.stamp_source!r}')
+
+    @classmethod
+    def for_channel(cls, channel: str, params: Mapping[str, Any] | None = None) -> TopicConfig:
+        """Return the configuration of ``channel``, defaults overridden by ``params``.
+
+        Parameters
+        ----------
+        channel : str
+            One of ``position``, ``pressure``, ``flow``.
+        params : mapping, optional
+            Keys as in ``params/topics.yaml``: ``command_topic``,
+            ``command_type``, ``command_field``, ``command_unit``,
+            ``<channel>_topic``, ``<channel>_type``, ``<channel>_field``,
+            ``<channel>_unit`` (keys of other channels are ignored) and
+            ``stamp_source``.
+
+        Raises
+        ------
+        ConfigError
+            Unknown channel or key, or an invalid value.
+        """
+        if channel not in _CHANNEL_DEFAULTS:
+            raise ConfigError(f'unknown channel {channel!r}; expected one of {CHANNELS}')
+        params = dict(params or {})
+        unknown = sorted(set(params) - _KEYS)
+        if unknown:
+            raise ConfigError(f'unknown topic key(s) {unknown}; known: {sorted(_KEYS)}')
+        defaults = _CHANNEL_DEFAULTS[channel]
+        values = {}
+        for role, prefix, default in (('command', 'command', _COMMAND_DEFAULTS),
+                                      ('measurement', channel, defaults)):
+            for i, suffix in enumerate(_SUFFIXES):
+                values[f'{role}_{suffix}'] = params.get(f'{prefix}_{suffix}', default[i])
+        values['stamp_source'] = params.get('stamp_source', 'header')
+        return cls(**values)
+
+
+def load_topic_config(yaml_path: str | Path, channel: str, *,
+                      node: str | None = None) -> TopicConfig:
+    """Read the topic configuration of ``channel`` from a params YAML file.
+
+    Accepted layouts: a top-level ``topics:`` mapping; or the ROS params-file
+    layout ``<node>: ros__parameters:`` with a ``topics:`` mapping inside or
+    the keys given flat (``command_topic``, ``<channel>_field``, ...) or
+    dotted (``topics.command_topic``). Sections are merged in file order;
+    with ``node`` only ``/**`` and that node's section count. A file without
+    any of these keys gives the defaults.
+
+    Raises
+    ------
+    ConfigError
+        Unreadable or invalid YAML, unknown keys in a ``topics:`` mapping,
+        invalid values.
+    """
+    yaml_path = Path(yaml_path)
+    doc = read_yaml(yaml_path)
+    doc = {} if doc is None else doc
+    if not isinstance(doc, dict):
+        raise ConfigError(f'{yaml_path}: expected a mapping at the top level')
+    merged: dict[str, Any] = {}
+
+    def take(where: str, section: Any, strict: bool) -> None:
+        if not isinstance(section, dict):
+            raise ConfigError(f'{yaml_path}: {where} must be a mapping')
+        if strict and set(section) - _KEYS:
+            raise ConfigError(f'{yaml_path}: unknown key(s) {sorted(set(section) - _KEYS)} in '
+                              f'{where}; known: {sorted(_KEYS)}')
+        merged.update({k: v for k, v in section.items() if k in _KEYS})
+
+    if 'topics' in doc:
+        take('topics', doc['topics'], True)
+    for key, value in doc.items():
+        if not (isinstance(value, dict) and 'ros__parameters' in value):
+            continue
+        if node is not None and str(key).strip('/') not in ('**', node.strip('/')):
+            continue
+        params = value['ros__parameters'] or {}
+        where = f'{key}.ros__parameters'
+        if not isinstance(params, dict):
+            raise ConfigError(f'{yaml_path}: {where} must be a mapping')
+        if 'topics' in params:
+            take(f'{where}.topics', params['topics'], True)
+        take(where, {k.removeprefix('topics.'): v for k, v in params.items()}, False)
+    try:
+        return TopicConfig.for_channel(channel, merged)
+    except ConfigError as exc:
+        raise ConfigError(f'{yaml_path}: {exc}') from None

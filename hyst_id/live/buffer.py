@@ -1,0 +1,82 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""Collect a live run's command and measurement samples and turn them into a Recording.
+
+:class:`SampleBuffer` keeps the two streams (stamps in ns) of the current
+run; :meth:`SampleBuffer.recording` pairs them exactly as the bag reader
+does (:func:`hyst_id.io.streams.pair_streams`).
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from hyst_id.io.recording import Recording
+from hyst_id.io.streams import pair_streams
+
+__all__ = ['SampleBuffer']
+
+
+class SampleBuffer:
+    """Command and measurement samples of the current run (stamps in ns).
+
+    Samples may arrive in any order (they are sorted when the recording is
+    built). At most ``max_samples`` of each stream are kept (the oldest are
+    dropped, in blocks of a tenth).
+    """
+
+    def __init__(self, max_samples: int = 2000000) -> None:
+        self.max_samples = int(max_samples)
+        self.clear()
+
+    def clear(self) -> None:
+        """Forget every sample."""
+        self.cmd_t: list[int] = []
+        self.cmd_v: list[float] = []
+        self.meas_t: list[int] = []
+        self.meas_v: list[float] = []
+        self.last_rx: float | None = None
+
+    def add_command(self, t_ns: int, value: float) -> None:
+        """Append a command sample."""
+        self.cmd_t.append(int(t_ns))
+        self.cmd_v.append(float(value))
+        self._trim(self.cmd_t, self.cmd_v)
+
+    def add_measurement(self, t_ns: int, value: float) -> None:
+        """Append a measurement sample."""
+        self.meas_t.append(int(t_ns))
+        self.meas_v.append(float(value))
+        self._trim(self.meas_t, self.meas_v)
+        self.last_rx = time.monotonic()
+
+    def _trim(self, t: list, v: list) -> None:
+        if len(t) > self.max_samples + self.max_samples // 10:
+            del t[:len(t) - self.max_samples]
+            del v[:len(v) - self.max_samples]
+
+    @property
+    def n_measurements(self) -> int:
+        """Measurements collected."""
+        return len(self.meas_t)
+
+    def recording(self, channel: str, source: str = '', units: tuple[str, str] = ('', ''),
+                  names: tuple[str, str] = ('command', 'measurement')) -> Recording:
+        """The run so far as a Recording (see :func:`pair_streams`)."""
+        return pair_streams(np.array(self.cmd_t, dtype=np.int64), np.array(self.cmd_v),
+                            np.array(self.meas_t, dtype=np.int64), np.array(self.meas_v),
+                            channel, source, units, names)

@@ -1,0 +1,47 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""What the nodes share: QoS and topic names, the parameter table, HystNode, helpers.
+
+Nodes import from here; the core never does (it does not import rclpy).
+"""
+
+from hyst_id.nodes.support.hyst_node import HystNode
+from hyst_id.nodes.support.params import field_params, Param, TOPIC_KEYS, topic_params
+from hyst_id.nodes.support.pusher import ParameterPusher
+from hyst_id.nodes.support.qos import (
+                                       COMMAND_QOS,
+                                       DESIRED_TOPIC,
+                                       DIAGNOSTICS_QOS,
+                                       DIAGNOSTICS_TOPIC,
+                                       IDENTIFIED_PARAMS_TOPIC,
+                                       LATCHED_QOS,
+                                       SENSOR_QOS,
+)
+from hyst_id.nodes.support.ros import (
+                                       diagnostic_array,
+                                       init_ros,
+                                       message_class,
+                                       source_time_ns,
+                                       spin_node,
+                                       stamp_ns,
+                                       try_publish,
+)
+
+__all__ = [
+    'COMMAND_QOS', 'DESIRED_TOPIC', 'DIAGNOSTICS_QOS', 'DIAGNOSTICS_TOPIC', 'HystNode',
+    'IDENTIFIED_PARAMS_TOPIC', 'LATCHED_QOS', 'Param', 'ParameterPusher', 'SENSOR_QOS',
+    'TOPIC_KEYS', 'diagnostic_array', 'field_params', 'init_ros', 'message_class',
+    'source_time_ns', 'spin_node', 'stamp_ns', 'topic_params', 'try_publish',
+]

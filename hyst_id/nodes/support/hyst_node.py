@@ -1,0 +1,147 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""HystNode: a Node whose parameters come from a table of :class:`~.params.Param`."""
+
+from __future__ import annotations
+
+from typing import Any, Mapping, Sequence
+
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from rcl_interfaces.msg import SetParametersResult
+from rclpy.exceptions import (
+    InvalidParameterTypeException,
+    InvalidParameterValueException,
+    ParameterException,
+)
+from rclpy.node import Node
+
+from hyst_id.errors import ConfigError
+from hyst_id.nodes.support.params import Param
+from hyst_id.nodes.support.qos import DIAGNOSTICS_QOS, DIAGNOSTICS_TOPIC
+from hyst_id.nodes.support.ros import diagnostic_array, first_line, try_publish
+
+__all__ = ['HystNode']
+
+_TYPE_NAMES = {bool: 'a bool', int: 'an integer', float: 'a double', str: 'a string',
+               list: 'an array'}
+
+
+class HystNode(Node):
+    """A Node whose parameters come from a :class:`Param` table.
+
+    Parameters
+    ----------
+    node_name : str
+        Default node name (remappable with ``__node:=``).
+    params : sequence of Param
+        Parameters to declare; defaults are those of the table unless
+        ``defaults`` overrides them (a params file still wins over both).
+    defaults : mapping, optional
+        Per-instance default values (used by ``bringup`` to run several
+        instances of one node with different roles).
+    **kwargs
+        Passed to :class:`rclpy.node.Node`.
+
+    Subclasses override :meth:`validate_params` (cross-parameter checks,
+    return a reason string to reject) and :meth:`apply_params` (act on an
+    accepted change). Startup values are validated too: an invalid params
+    file raises :class:`~hyst_id.errors.ConfigError`.
+    """
+
+    def __init__(self, node_name: str, params: Sequence[Param],
+                 defaults: Mapping[str, Any] | None = None, **kwargs: Any) -> None:
+        super().__init__(node_name, **kwargs)
+        self._param_table = {p.name: p for p in params}
+        self._diag_pub = None
+        #: Parameter changes rejected since the start.
+        self.rejected_updates = 0
+        defaults = dict(defaults or {})
+        unknown = set(defaults) - set(self._param_table)
+        if unknown:
+            raise ConfigError(f'{node_name}: unknown parameter defaults {sorted(unknown)}')
+        for p in params:
+            default = defaults.get(p.name, p.default)
+            try:
+                self.declare_parameter(p.name, default, p.descriptor())
+            except InvalidParameterTypeException as exc:
+                raise ConfigError(
+                    f'parameter {p.name} must be {_TYPE_NAMES.get(type(default), "")} '
+                    f'(like {default!r}); the params file gives another type '
+                    f'({first_line(exc)})') from None
+            except (InvalidParameterValueException, ParameterException) as exc:
+                raise ConfigError(f'parameter {p.name}: {first_line(exc)}') from None
+        values = self.param_values()
+        reason = self._check_all(values, set(values))
+        if reason:
+            raise ConfigError(f'invalid parameters: {reason}')
+        self.add_on_set_parameters_callback(self._on_set_parameters)
+
+    # --------------------------------------------------------------- params
+    def param_values(self) -> dict[str, Any]:
+        """Current values of every declared table parameter."""
+        return {name: self.get_parameter(name).value for name in self._param_table}
+
+    def p(self, name: str) -> Any:
+        """Current value of parameter ``name``."""
+        return self.get_parameter(name).value
+
+    def validate_params(self, values: dict[str, Any], changed: set[str]) -> str | None:
+        """Return why the candidate parameter ``values`` are invalid, or None."""
+        return None
+
+    def apply_params(self, values: dict[str, Any], changed: set[str]) -> None:
+        """Act on an accepted change (``values`` are the new values of all parameters)."""
+
+    def _check_all(self, values: dict[str, Any], changed: set[str]) -> str | None:
+        for name in sorted(changed):
+            spec = self._param_table.get(name)
+            if spec is not None:
+                reason = spec.check(values[name])
+                if reason:
+                    return reason
+        return self.validate_params(values, changed)
+
+    def _on_set_parameters(self, params: list) -> SetParametersResult:
+        values = self.param_values()
+        changed = set()
+        for prm in params:
+            if prm.name in self._param_table:
+                values[prm.name] = prm.value
+                changed.add(prm.name)
+        if not changed:
+            return SetParametersResult(successful=True)
+        try:
+            reason = self._check_all(values, changed)
+        except Exception as exc:  # noqa: BLE001 - a bad value must never kill the node
+            reason = f'{type(exc).__name__}: {first_line(exc)}'
+        if reason:
+            self.rejected_updates += 1
+            self.get_logger().warning(f'rejected parameter change '
+                                      f'{", ".join(sorted(changed))}: {reason}')
+            return SetParametersResult(successful=False, reason=reason)
+        self.apply_params(values, changed)
+        return SetParametersResult(successful=True)
+
+    # ---------------------------------------------------------- diagnostics
+    def publish_diagnostics(self, level: int, message: str,
+                            values: Mapping[str, Any] | None = None,
+                            extra: Sequence[DiagnosticStatus] = ()) -> None:
+        """Publish a DiagnosticStatus named ``hyst_id: <node name>`` (then ``extra``)."""
+        if self._diag_pub is None:
+            self._diag_pub = self.create_publisher(DiagnosticArray, DIAGNOSTICS_TOPIC,
+                                                   DIAGNOSTICS_QOS)
+        arr = diagnostic_array(self, f'hyst_id: {self.get_name()}', level, message, values)
+        arr.status.extend(extra)
+        try_publish(self._diag_pub, arr)

@@ -1,0 +1,136 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""Small ROS helpers the nodes share: init, spin, publish, stamps, message types.
+
+:func:`spin_node` is the body of every node's ``main()`` (init, spin,
+shutdown); the rest turn middleware failures and type names into values
+and one-line errors.
+"""
+
+from __future__ import annotations
+
+import importlib
+import sys
+from typing import Any, Mapping
+
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+import rclpy
+from rclpy.executors import ExternalShutdownException
+from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
+from rclpy.node import Node
+
+from hyst_id.errors import ConfigError, HystIdError
+
+__all__ = ['diagnostic_array', 'first_line', 'init_ros', 'message_class', 'source_time_ns',
+           'spin_node', 'stamp_ns', 'try_publish']
+
+_RCLError = _rclpy.RCLError
+
+
+def message_class(type_name: str) -> type:
+    """Import a message class from ``pkg/msg/Name`` (or ``pkg/Name``)."""
+    parts = [p for p in str(type_name).split('/') if p]
+    if len(parts) == 2:
+        parts = [parts[0], 'msg', parts[1]]
+    if len(parts) != 3:
+        raise ConfigError(f'bad message type {type_name!r}: expected pkg/msg/Name')
+    try:
+        module = importlib.import_module(f'{parts[0]}.{parts[1]}')
+        return getattr(module, parts[2])
+    except (ImportError, AttributeError):
+        raise ConfigError(f'message type {type_name} is not installed') from None
+
+
+def init_ros(args: list[str] | None, name: str) -> bool:
+    """``rclpy.init``; on bad command-line arguments print one line and return False."""
+    try:
+        rclpy.init(args=args)
+    except Exception as exc:  # noqa: BLE001 - rcl's RCLError for a malformed --ros-args
+        print(f'{name}: error: {first_line(exc)}', file=sys.stderr)
+        return False
+    return True
+
+
+def try_publish(publisher: Any, msg: Any) -> bool:
+    """Publish ``msg``; return False instead of raising when the middleware refuses it.
+
+    With :data:`COMMAND_QOS` (reliable, keep all) ``publish`` blocks while a
+    subscriber's reader cache is full and fails after the writer's
+    ``max_blocking_time``; the caller counts and reports the failure (or
+    retries) instead of dying in a callback.
+    """
+    try:
+        publisher.publish(msg)
+    except _RCLError:
+        return False
+    return True
+
+
+def source_time_ns(node: Node, info: Mapping[str, Any]) -> int:
+    """A message's source timestamp (from the middleware), else its receive time, else now."""
+    return int(info.get('source_timestamp') or 0) or int(
+        info.get('received_timestamp') or 0) or node.get_clock().now().nanoseconds
+
+
+def spin_node(node_class: type, name: str, args: list[str] | None = None) -> int:
+    """Init, spin and shut down one node: the body of every node's ``main()``.
+
+    The demo_nodes_py pattern: Ctrl-C and an external shutdown (SIGTERM) end
+    the spin quietly; a :class:`~hyst_id.errors.HystIdError` raised while the
+    node is built (a bad params file) is logged in one line with exit code 2;
+    the node is always destroyed and the context shut down.
+    """
+    if not init_ros(args, name):
+        return 2
+    node = None
+    try:
+        node = node_class()
+        rclpy.spin(node)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    except HystIdError as exc:
+        rclpy.logging.get_logger(name).error(str(exc))
+        return 2
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+    return 0
+
+
+def stamp_ns(stamp: Any) -> int:
+    """Nanoseconds of a ``builtin_interfaces/Time``."""
+    return int(stamp.sec) * 1_000_000_000 + int(stamp.nanosec)
+
+
+def diagnostic_array(node: Node, name: str, level: int | bytes, message: str,
+                     values: Mapping[str, Any] | None = None) -> DiagnosticArray:
+    """Build a one-status DiagnosticArray stamped now."""
+    status = DiagnosticStatus(name=name, hardware_id=node.get_fully_qualified_name(),
+                              message=message)
+    status.level = level if isinstance(level, bytes) else bytes([int(level)])
+    for key, val in (values or {}).items():
+        text = f'{val:.6g}' if isinstance(val, float) else str(val)
+        status.values.append(KeyValue(key=str(key), value=text))
+    arr = DiagnosticArray()
+    arr.header.stamp = node.get_clock().now().to_msg()
+    arr.status.append(status)
+    return arr
+
+
+def first_line(exc: BaseException) -> str:
+    """First line of an exception's message (its type name when empty)."""
+    text = str(exc).strip().splitlines()
+    return text[0] if text else type(exc).__name__

@@ -1,0 +1,225 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""Fuzz-style bad input for the recording reader and the CLI (issue 6).
+
+Every case must end in one clear line on stderr and a non-zero exit, with no
+traceback, and must leave every file on disk untouched. The list of cases is
+``CASES`` below; ``docs/reliability.md`` lists them for users.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from pathlib import Path
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from hyst_id.cli import main
+from hyst_id.io.bag import BagWriter, write_recording_bag
+from hyst_id.io.recording import Recording
+from hyst_id.io.topics import TopicConfig
+
+T = np.arange(0.0, 40.0, 0.05)
+V = 9 + 2 * np.sin(2 * np.pi * T / 10)
+Y = 1.05 * (V - 0.5)
+
+
+def write_csv(path: Path, t=T, v=V, y=Y, header='t,command,measurement') -> Path:
+    rows = [header] if header else []
+    rows += [f'{a:.17g},{b:.17g},{c:.17g}' for a, b, c in zip(t, v, y)]
+    path.write_text('\n'.join(rows) + '\n')
+    return path
+
+
+def make_bag(path: Path, **changes) -> Path:
+    values = {'t_s': T, 'command': V, 'measurement': Y, **changes}
+    rec = Recording(values['t_s'], values['command'], values['measurement'], 'position')
+    write_recording_bag(path, rec)
+    return path
+
+
+def truncated_bag(tmp: Path) -> Path:
+    bag = make_bag(tmp / 'full')
+    mcap = next(bag.glob('*.mcap'))
+    data = mcap.read_bytes()
+    out = tmp / 'truncated.mcap'
+    out.write_bytes(data[:len(data) // 2])
+    return out
+
+
+def wrong_type_bag(tmp: Path) -> Path:
+    path = tmp / 'wrong_type'
+    cfg = TopicConfig.for_channel('position')
+    with BagWriter(path) as writer:
+        writer.add_topic(cfg.command_topic, 'std_msgs/msg/Float64')
+        writer.add_topic(cfg.measurement_topic, 'std_msgs/msg/String')
+        for i, t in enumerate(T):
+            t_ns = int(1e18 + t * 1e9)
+            writer.write(cfg.command_topic, t_ns, {'data': float(V[i])})
+            writer.write(cfg.measurement_topic, t_ns, {'data': 'not a number'})
+    return path
+
+
+def no_topics_bag(tmp: Path) -> Path:
+    path = tmp / 'other_topics'
+    with BagWriter(path) as writer:
+        writer.add_topic('/something/else', 'std_msgs/msg/Float64')
+        for t in T[:50]:
+            writer.write('/something/else', int(1e18 + t * 1e9), {'data': 1.0})
+    return path
+
+
+def empty_topic_bag(tmp: Path) -> Path:
+    path = tmp / 'empty_topic'
+    cfg = TopicConfig.for_channel('position')
+    with BagWriter(path) as writer:
+        writer.add_topic(cfg.command_topic, 'std_msgs/msg/Float64')
+        writer.add_topic(cfg.measurement_topic, 'sensor_msgs/msg/JointState')
+        for i, t in enumerate(T):
+            writer.write(cfg.command_topic, int(1e18 + t * 1e9), {'data': float(V[i])})
+    return path
+
+
+def nan_at(arr, i=10):
+    out = np.array(arr, dtype=float)
+    out[i] = np.nan
+    return out
+
+
+def with_gap(t):
+    out = np.array(t, dtype=float)
+    out[400:] += 500.0
+    return out
+
+
+def dup_t(t):
+    out = np.array(t, dtype=float)
+    out[20] = out[19]
+    return out
+
+
+def back_t(t):
+    out = np.array(t, dtype=float)
+    out[20], out[21] = out[21], out[20]
+    return out
+
+
+#: (case id, builder(tmp) -> argv after 'identify', expected text in the error line)
+CASES = [
+    ('missing-file', lambda d: [str(d / 'nope.csv')], 'no such file'),
+    ('empty-csv', lambda d: [str(_touch(d / 'empty.csv'))], 'empty'),
+    ('header-only-csv', lambda d: [str(_text(d / 'h.csv', 't,command,measurement\n'))],
+     'no data'),
+    ('missing-column', lambda d: [str(write_csv(d / 'm.csv', header='t,cmd,measurement'))],
+     'command'),
+    ('non-numeric-cell',
+     lambda d: [str(_text(d / 'x.csv', 't,command,measurement\n0,1,2\n0.1,abc,2\n'))], 'line'),
+    ('ragged-rows', lambda d: [str(_text(d / 'r.csv', 't,command,measurement\n0,1,2\n0.1,2\n'))],
+     'line'),
+    ('nan-measurement', lambda d: [str(write_csv(d / 'n.csv', y=nan_at(Y)))], 'NaN'),
+    ('inf-command', lambda d: [str(write_csv(d / 'i.csv', v=np.where(T > 3, np.inf, V)))],
+     'NaN/inf'),
+    ('duplicate-timestamps', lambda d: [str(write_csv(d / 'd.csv', t=dup_t(T)))], 'duplicate'),
+    ('backwards-timestamps', lambda d: [str(write_csv(d / 'b.csv', t=back_t(T)))], 'backwards'),
+    ('huge-values', lambda d: [str(write_csv(d / 'hv.csv', y=Y * 1e20))], 'beyond'),
+    ('gap', lambda d: [str(write_csv(d / 'g.csv', t=with_gap(T)))], 'gap'),
+    ('constant-command', lambda d: [str(write_csv(d / 'c.csv', v=np.full_like(V, 9.0)))],
+     'constant'),
+    ('no-reversal', lambda d: [str(write_csv(d / 'ramp.csv', v=np.linspace(7, 11, T.size)))],
+     'reverses'),
+    ('too-few-samples', lambda d: [str(write_csv(d / 'few.csv', t=T[:5], v=V[:5], y=Y[:5]))],
+     'too few'),
+    ('truncated-mcap', lambda d: [str(truncated_bag(d))], 'bag'),
+    ('random-bytes-mcap', lambda d: [str(_bytes(d / 'junk.mcap', np.random.default_rng(0)
+                                                .bytes(4096)))], 'bag'),
+    ('zero-byte-mcap', lambda d: [str(_bytes(d / 'zero.mcap', b''))], 'bag'),
+    ('bag-without-topics', lambda d: [str(no_topics_bag(d))], '/hyst_id/'),
+    ('wrong-message-type', lambda d: [str(wrong_type_bag(d))], 'expected sensor_msgs'),
+    ('empty-topic', lambda d: [str(empty_topic_bag(d))], '/hyst_id/position'),
+    ('nan-in-bag', lambda d: [str(make_bag(d / 'nanbag', measurement=nan_at(Y)))], 'NaN'),
+    ('constant-command-bag', lambda d: [str(make_bag(d / 'cbag', command=np.full_like(V, 9.)))],
+     'constant'),
+    ('inverted-domain', lambda d: [str(write_csv(d / 'ok1.csv')), '--domains',
+                                   str(_text(d / 'dom.yaml', 'm_l: [5, 1]\n'))], 'low < high'),
+    ('infeasible-domains', lambda d: [str(write_csv(d / 'ok2.csv')), '--domains',
+                                      str(_text(d / 'dom2.yaml', 'm_l: [0.1, 0.5]\n'
+                                                'm_r: [0.1, 0.5]\nm_t: [1, 2]\n'))],
+     'feasible'),
+    ('domains-file-missing', lambda d: [str(write_csv(d / 'ok3.csv')), '--domains',
+                                        str(d / 'nodomains.yaml')], 'cannot read'),
+    ('domains-not-yaml', lambda d: [str(write_csv(d / 'ok4.csv')), '--domains',
+                                    str(_text(d / 'bad.yaml', 'm_l: [1, \n'))], 'YAML'),
+    ('bad-columns-option', lambda d: [str(write_csv(d / 'ok5.csv')), '--columns', 't,command'],
+     'three'),
+]
+
+
+def _touch(path: Path) -> Path:
+    path.touch()
+    return path
+
+
+def _text(path: Path, text: str) -> Path:
+    path.write_text(text)
+    return path
+
+
+def _bytes(path: Path, data: bytes) -> Path:
+    path.write_bytes(data)
+    return path
+
+
+def snapshot(root: Path) -> dict[str, str]:
+    """Hash every file below ``root``."""
+    return {str(p.relative_to(root)): hashlib.sha256(p.read_bytes()).hexdigest()
+            for p in sorted(root.rglob('*')) if p.is_file()}
+
+
+@pytest.mark.parametrize('case, build, expected', CASES, ids=[c[0] for c in CASES])
+def test_bad_input_gives_one_line_and_nonzero_exit(tmp_path, capsys, case, build, expected):
+    argv = build(tmp_path)
+    before = snapshot(tmp_path)
+    code = main(['identify', *argv, '--quiet', '--seeds', '1', '--generations', '5',
+                 '--workers', '1'])
+    err = capsys.readouterr().err
+    assert code != 0, f'{case}: exit code 0'
+    assert 'Traceback' not in err
+    error_lines = [line for line in err.splitlines() if line.startswith('hyst-id: ')]
+    assert len(error_lines) == 1, f'{case}: stderr was {err!r}'
+    assert 'internal error' not in error_lines[0], error_lines[0]
+    assert expected.lower() in error_lines[0].lower(), error_lines[0]
+    assert snapshot(tmp_path) == before, f'{case}: files on disk changed'
+
+
+def test_case_list_covers_the_issue():
+    names = {c[0] for c in CASES}
+    for needed in ('truncated-mcap', 'random-bytes-mcap', 'bag-without-topics',
+                   'wrong-message-type', 'nan-measurement', 'duplicate-timestamps',
+                   'backwards-timestamps', 'gap', 'constant-command', 'huge-values',
+                   'empty-csv', 'missing-column'):
+        assert needed in names
+
+
+def test_real_process_exit_code_and_stderr(tmp_path):
+    """The installed entry point, as a user runs it: exit 2, one line, no traceback."""
+    bad = write_csv(tmp_path / 'nan.csv', y=nan_at(Y))
+    proc = subprocess.run([sys.executable, '-m', 'hyst_id.cli', 'identify', str(bad)],
+                          capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 2
+    assert proc.stderr.strip().count('\n') == 0, proc.stderr
+    assert proc.stderr.startswith('hyst-id: error:')

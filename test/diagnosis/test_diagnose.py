@@ -1,0 +1,252 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""Diagnosis: each mechanism's own block switched on is named; clean data gets ``none``.
+
+Recordings are made with the diagnosis's own composed model
+(:class:`hyst_id.diagnosis.model.ComposedModel`): the paper's chain with one
+block at known values, white noise on top. The blind test on recordings of
+the rig simulator is ``test_concealed_bags.py``.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from hyst_id.cli import main
+from hyst_id.diagnosis import diagnose, DiagnoseSettings
+from hyst_id.diagnosis.baseline import loop_width
+from hyst_id.diagnosis.locate import locate, noise_std
+from hyst_id.diagnosis.mechanisms import Context, MECHANISM_IDS, MECHANISMS
+from hyst_id.diagnosis.model import ComposedModel
+from hyst_id.diagnosis.report import plot_diagnosis
+from hyst_id.errors import ConfigError, NoExcitationError, RecordingError
+from hyst_id.identification.chains import chain_spec
+from hyst_id.io.recording import Recording
+from hyst_id.signals.excitation import multisine
+
+__all__: list[str] = []
+
+#: The paper's induced hysteresis with a small backlash; 0.5 s pressure lag.
+CHAIN = np.array([1.01, 1.05, 0.10, 0.15, -0.25, 0.50, 14.0, 7.0, 1.0, -0.15, 0.15, 0.5])
+FAST = DiagnoseSettings(seeds=(0,), generations=120, max_mechanisms=1)
+
+#: mechanism -> (channel, theta, linear coefficients of the model's columns)
+CASES = {
+    'dead_time': ('position', [0.2], None),
+    'sensor_lag': ('position', [0.3], None),
+    'supply_decay': ('pressure', [1.0 / 600.0], [1.0, 0.0, 0.0]),
+    'offset_drift': ('position', [], [1.0, 0.004, 0.0]),
+    'saturation': ('position', [0.15, 0.15], None),
+    'stiction': ('position', [0.04, 0.01], None),
+    'static_nonlinearity': ('position', [], [1.0, 0.25, 0.1, 9.0]),
+    'rate_dependence': ('position', [0.3, 1.0], None),
+}
+
+
+def synthetic(mech: str | None, *, seed: int = 0, duration_s: float = 120.0,
+              noise: float = 0.005) -> Recording:
+    """A multisine run of the chain with one block (or none) and white noise."""
+    channel, theta, coef = CASES[mech] if mech else ('position', [], None)
+    t = np.arange(0.0, duration_s, 0.05)
+    v = multisine(t, amplitude_ma=1.8)
+    ctx = Context(channel, t, t.size)
+    mechs = [MECHANISMS[mech]] if mech else []
+    n_chain = 12 if channel == 'pressure' else 11
+    model = ComposedModel(channel, mechs, ctx, chain_spec(channel).bounds)
+    p = np.concatenate([CHAIN[:n_chain], np.asarray(theta, dtype=float)])
+    a = model.evaluate(p, t, v, t.size).matrix()
+    coef = np.asarray(coef if coef is not None else [1.0] + [0.0] * (a.shape[1] - 1))
+    y = a @ coef
+    y = y + np.random.default_rng(seed).normal(0.0, noise, t.size)
+    return Recording(t, v, y, channel, 'mA', 'mA-eq', f'synthetic {mech or "clean"}')
+
+
+@pytest.fixture(scope='module')
+def clean_diagnosis():
+    return diagnose(synthetic(None, seed=3), settings=FAST)
+
+
+@pytest.fixture(scope='module')
+def delay_diagnosis():
+    return diagnose(synthetic('dead_time', seed=4), settings=FAST)
+
+
+def test_clean_recording_gets_none(clean_diagnosis):
+    d = clean_diagnosis
+    assert d.verdict == 'none'
+    assert d.findings == []
+    assert d.final.er_holdout_percent < 1.3 * d.noise_floor_percent
+
+
+def test_dead_time_is_named_with_its_value(delay_diagnosis):
+    d = delay_diagnosis
+    assert d.verdict == 'dead_time'
+    f = d.findings[0]
+    assert f.params['delay_s'].value == pytest.approx(0.2, abs=0.02)
+    assert f.params['delay_s'].unit == 's'
+    assert f.er_holdout_after_percent < 0.7 * f.er_holdout_before_percent
+    assert f.er_holdout_after_percent < 1.5 * d.noise_floor_percent
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize('mech', [m for m in MECHANISM_IDS if m != 'dead_time'])
+def test_each_mechanism_is_named(mech):
+    d = diagnose(synthetic(mech, seed=5), settings=FAST)
+    assert d.verdict == mech, d.report()
+    f = d.findings[0]
+    assert f.explanation and f.params
+    if mech == 'stiction':
+        check_stick_slip(d, band=0.04 * loop_travel(synthetic(None, seed=5)))
+        return
+    assert f.er_holdout_after_percent < 0.7 * f.er_holdout_before_percent
+
+
+def loop_travel(rec: Recording) -> float:
+    """Travel of the chain's demand ``B(H(v))`` over a whole synthetic record."""
+    return float(np.ptp(chain_spec('position').signal(CHAIN[:11], rec.t_s, rec.command)))
+
+
+def check_stick_slip(d, band: float) -> None:
+    """Stiction's own criteria (docs/diagnosis.md, stick-slip).
+
+    The staircase is lined up on the training part (every slip on its
+    measured sample: training %e_r at the noise floor) and the slip band is
+    recovered. On held-out data a slip that falls while the demand barely
+    moves can land a sample off and cost a whole jump there, so one record
+    is only required to improve clearly; how often held-out data end at the
+    floor is :func:`test_stick_slip_is_lined_up_on_held_out_data_mostly`.
+    """
+    f = d.findings[0]
+    assert f.er_train_after_percent < 1.5 * d.noise_floor_train_percent, d.report()
+    assert f.params['slip_band'].value == pytest.approx(band, rel=0.03)
+    assert f.er_holdout_after_percent < 0.8 * f.er_holdout_before_percent, d.report()
+
+
+@pytest.mark.slow
+def test_stick_slip_is_lined_up_on_held_out_data_mostly():
+    """Twelve noise seeds: every one named, at least half at the floor on held-out data.
+
+    9 of 12 were at the time of writing (docs/diagnosis.md).
+    """
+    ratios = []
+    for seed in range(5, 17):
+        d = diagnose(synthetic('stiction', seed=seed), settings=FAST)
+        assert d.verdict == 'stiction', d.report()
+        ratios.append(d.final.er_holdout_percent / d.noise_floor_percent)
+    assert sum(r < 1.5 for r in ratios) >= 6, np.round(ratios, 2)
+
+
+def test_json_document_has_the_issue_schema(delay_diagnosis, tmp_path):
+    doc = json.loads(json.dumps(delay_diagnosis.to_dict()))
+    for key in ('channel', 'verdict', 'baseline', 'noise_floor_percent', 'findings', 'final'):
+        assert key in doc
+    assert set(doc['baseline']) >= {'er_train_percent', 'er_holdout_percent'}
+    f = doc['findings'][0]
+    assert set(f) >= {'mechanism', 'explanation', 'where', 'params',
+                      'er_holdout_before_percent', 'er_holdout_after_percent'}
+    assert set(doc['final']) >= {'mechanisms', 'er_train_percent', 'er_holdout_percent'}
+    assert doc['final']['mechanisms'] == ['dead_time']
+    assert f['params']['delay_s']['unit'] == 's'
+
+
+def test_status_for_diagnostics(delay_diagnosis, clean_diagnosis):
+    level, message, values = delay_diagnosis.status()
+    assert level == 'warn' and message.startswith('dead_time')
+    assert values['verdict'] == 'dead_time' and values['dead_time.delay_s'].endswith(' s')
+    assert all(isinstance(v, str) for v in values.values())
+    assert clean_diagnosis.status()[0] == 'ok'
+
+
+def test_report_and_figure(delay_diagnosis, clean_diagnosis, tmp_path):
+    text = delay_diagnosis.report()
+    assert 'verdict: dead_time' in text and 'held-out %e_r' in text
+    assert 'verdict: none' in clean_diagnosis.report()
+    path = plot_diagnosis(delay_diagnosis, tmp_path / 'fig.png')
+    assert path.stat().st_size > 10_000
+
+
+def test_locate_white_noise_is_white_and_a_delay_is_not():
+    rng = np.random.default_rng(1)
+    t = np.arange(0.0, 100.0, 0.05)
+    v = multisine(t)
+    y = rng.normal(0.0, 1.0, t.size)
+    loc = locate(t, v, y, np.zeros_like(y), 1.0)
+    assert loc.white and loc.independent and not loc.structured
+    rate = np.gradient(v, t)
+    loc = locate(t, v, y + 3.0 * rate, np.zeros_like(y), 1.0)
+    assert loc.ccf_rate['significant'] and loc.structured
+
+
+def test_noise_estimate_ignores_quantisation_and_jumps():
+    rng = np.random.default_rng(2)
+    y = np.round((rng.normal(0.0, 1.0, 4000) + np.linspace(0, 50, 4000)) / 0.8) * 0.8
+    assert noise_std(y) == pytest.approx(1.03, rel=0.08)
+    stairs = np.floor(np.linspace(0.0, 400.0, 4000) / 10.0) * 10.0   # jumps every 100 samples
+    assert noise_std(stairs + rng.normal(0.0, 1.0, 4000)) == pytest.approx(1.0, rel=0.08)
+
+
+def test_loop_width_of_the_paper_loop():
+    rec = synthetic(None)
+    w = loop_width(rec.t_s, rec.command, rec.measurement)
+    assert 0.3 < w < 2.0
+
+
+def test_bad_inputs_are_one_line_errors():
+    rec = synthetic(None)
+    short = Recording(rec.t_s[:30], rec.command[:30], rec.measurement[:30], 'position')
+    with pytest.raises(RecordingError) as info:
+        diagnose(short, settings=FAST)
+    assert '\n' not in str(info.value)
+    flat = Recording(rec.t_s, np.full_like(rec.t_s, 9.0), rec.measurement, 'position')
+    with pytest.raises(NoExcitationError):
+        diagnose(flat, settings=FAST)
+    with pytest.raises(ConfigError, match='unknown mechanism'):
+        diagnose(rec, settings=DiagnoseSettings(mechanisms=('friction',)))
+    with pytest.raises(ConfigError, match='train fraction'):
+        diagnose(rec, settings=DiagnoseSettings(train_fraction=1.5))
+
+
+def test_cli_errors_are_one_line(tmp_path, capsys):
+    assert main(['diagnose', str(tmp_path / 'missing.csv')]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith('hyst-id: error:') and '\n' not in err
+    csv = tmp_path / 'r.csv'
+    rec = synthetic(None)
+    np.savetxt(csv, np.c_[rec.t_s, rec.command, rec.measurement], delimiter=',',
+               header='t,command,measurement', comments='')
+    assert main(['diagnose', str(csv), '--mechanisms', 'friction']) == 2
+    assert 'unknown mechanism' in capsys.readouterr().err
+
+
+def test_cli_writes_json_and_figure(tmp_path, capsys):
+    rec = synthetic('offset_drift', seed=7)
+    csv = tmp_path / 'drift.csv'
+    np.savetxt(csv, np.c_[rec.t_s, rec.command, rec.measurement], delimiter=',',
+               header='t,command,measurement', comments='')
+    out = tmp_path / 'd.json'
+    fig = tmp_path / 'd.png'
+    code = main(['diagnose', str(csv), '--seeds', '1', '--generations', '100', '--workers', '1',
+                 '--max-mechanisms', '1', '--json', str(out), '--plot', str(fig), '--quiet'])
+    assert code == 0
+    doc = json.loads(out.read_text())
+    assert doc['verdict'] == 'offset_drift'
+    rate = doc['findings'][0]['params']['rate_per_s']['value']
+    assert rate == pytest.approx(0.004, rel=0.1)
+    assert Path(fig).exists()
+    assert 'verdict: offset_drift' in capsys.readouterr().out

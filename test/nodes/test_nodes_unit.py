@@ -1,0 +1,397 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""The ROS nodes in-process: defaults, parameter validation, compensator swaps, I/O.
+
+Each test gets its own rclpy context and ROS domain (localhost discovery).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+
+from conftest import make_node, spin_nodes_until
+import numpy as np
+import pytest
+
+rclpy = pytest.importorskip('rclpy')
+
+from rclpy.node import Node  # noqa: E402
+from rclpy.parameter import Parameter  # noqa: E402
+from std_msgs.msg import Float64, String  # noqa: E402
+
+from hyst_id.errors import ConfigError, RecordingError  # noqa: E402
+from hyst_id.identification import identify  # noqa: E402
+from hyst_id.identification.chains import chain_spec  # noqa: E402
+from hyst_id.io.bag import iter_bag_messages, write_recording_bag  # noqa: E402
+from hyst_id.io.params_file import (  # noqa: E402
+    COMPENSATOR_NAMES,
+    read_compensator_params,
+    write_compensator_params,
+)
+from hyst_id.io.recording import Recording  # noqa: E402
+from hyst_id.live import pair_streams  # noqa: E402
+from hyst_id.nodes.actuator_driver import (  # noqa: E402
+    ActuatorDriver,
+    PAPER_BACKLASH,
+    PAPER_HYSTERESIS,
+    SimulatedActuator,
+)
+from hyst_id.nodes.bringup import control_error_percent  # noqa: E402
+from hyst_id.nodes.compensator import Compensator  # noqa: E402
+from hyst_id.nodes.excitation import Excitation  # noqa: E402
+from hyst_id.nodes.identifier import Identifier  # noqa: E402
+from hyst_id.nodes.pipeline_sim import PipelineSim  # noqa: E402
+from hyst_id.nodes.recorder import Recorder  # noqa: E402
+from hyst_id.nodes.replay import Replay  # noqa: E402
+from hyst_id.nodes.support import LATCHED_QOS  # noqa: E402
+from hyst_id.signals.excitation import eq24  # noqa: E402
+
+pytestmark = pytest.mark.ros
+
+PAPER = {**PAPER_HYSTERESIS, 'm_bl': 1.0, 'c_bl': -0.25, 'c_br': 0.25}
+
+
+_make = make_node
+
+
+def _spin_until(ctx, nodes, predicate, timeout=10.0):
+    return spin_nodes_until(ctx[0], nodes, predicate, timeout)
+
+
+def _set(node, **values):
+    return node.set_parameters_atomically([Parameter(k, value=v) for k, v in values.items()])
+
+
+# ------------------------------------------------------------------ construction
+def test_every_node_starts_with_defaults(ctx, tmp_path):
+    bag = write_recording_bag(tmp_path / 'tiny', Recording(
+        np.arange(30) * 0.1, 9 + np.sin(np.arange(30)), np.arange(30) * 1.0, 'position'))
+    nodes = [
+        _make(ctx, ActuatorDriver), _make(ctx, PipelineSim), _make(ctx, Excitation),
+        _make(ctx, Identifier), _make(ctx, Compensator),
+        _make(ctx, Recorder, parameter_overrides=[
+            Parameter('output', value=str(tmp_path / 'rec'))]),
+        _make(ctx, Replay, parameter_overrides=[Parameter('bag', value=str(bag)),
+                                                Parameter('shutdown_when_done', value=False)]),
+    ]
+    for node in nodes:
+        names = list(node._param_table)
+        for desc in node.describe_parameters(names):
+            assert desc.description, f'{node.get_name()}.{desc.name} has no description'
+        assert node.get_parameter('use_sim_time').value is False
+    comp = nodes[4]
+    assert comp.model is None
+    assert comp.step(9.5) == 9.5                 # pass-through with no parameter set
+    assert comp.step(30.0) == 20.0               # ... within the command limits
+
+
+def test_defaults_match_the_params_files():
+    """params/<node>.yaml holds exactly the built-in defaults."""
+    import importlib
+    from pathlib import Path
+
+    import yaml
+    root = Path(__file__).resolve().parents[2] / 'params'
+    for name in ('actuator_driver', 'pipeline_sim', 'excitation', 'identifier', 'compensator',
+                 'recorder', 'replay'):
+        mod = importlib.import_module(f'hyst_id.nodes.{name}')
+        doc = yaml.safe_load((root / f'{name}.yaml').read_text())[name]['ros__parameters']
+        nested = doc.get('topics') if isinstance(doc.get('topics'), dict) else {}
+        flat = {k: v for k, v in doc.items() if not (k == 'topics' and nested)}
+        flat.update({f'topics.{k}': v for k, v in nested.items()})
+        table = {p.name: p.default for p in mod.PARAMS}
+        assert set(flat) == set(table), name
+        for key, default in table.items():
+            if isinstance(default, float) and math.isnan(default):
+                assert math.isnan(flat[key]), (name, key)
+            else:
+                assert flat[key] == default and type(flat[key]) is type(default), (name, key)
+
+
+# ------------------------------------------------------------------ validation
+@pytest.mark.parametrize('cls, values, needle', [
+    (Compensator, {'min_command': 25.0}, 'min_command'),
+    (Compensator, {'diagnostics_period_s': 0.0}, 'diagnostics_period_s'),
+    (Compensator, {'channel': 'torque'}, 'one of'),
+    (Compensator, {'topics.command_topic': '/x'}, 'read-only'),
+    (Compensator, {'output_sign': 0.5}, 'output_sign'),
+    (Compensator, {**PAPER, 'c_l': 0.9}, 'not proper'),
+    (Compensator, {**PAPER, 'm_t': 2.0}, 'm_t'),
+    (Compensator, {**PAPER, 'm_l': math.inf}, 'finite'),
+    (ActuatorDriver, {'m_b': 1.5}, 'm_b'),
+    (Excitation, {'profile': 'square'}, 'one of'),
+    (Excitation, {'hold_s': -1.0}, 'hold_s'),
+    (Identifier, {'domains': '/no/such/domains.yaml'}, 'domains'),
+    (Identifier, {'pop_size': 1}, 'pop_size'),
+])
+def test_bad_parameters_are_rejected_with_a_reason(ctx, cls, values, needle):
+    node = _make(ctx, cls)
+    before = node.param_values()
+    result = _set(node, **values)
+    assert not result.successful
+    assert needle in result.reason, result.reason
+    assert node.param_values().keys() == before.keys()
+    for key in values:
+        a, b = node.p(key), before[key]
+        assert a == b or (isinstance(a, float) and math.isnan(a) and math.isnan(b))
+
+
+def test_bad_params_file_is_a_one_line_config_error(ros_domain, tmp_path):
+    bad_value = tmp_path / 'bad.yaml'
+    bad_value.write_text('compensator:\n  ros__parameters:\n' + ''.join(
+        f'    {k}: {float(v)!r}\n' for k, v in {**PAPER, 'c_l': 0.9}.items()))
+    bad_type = tmp_path / 'type.yaml'
+    bad_type.write_text('compensator:\n  ros__parameters:\n    max_command: 20\n')
+    for path, needle in ((bad_value, 'not proper'), (bad_type, 'double')):
+        context = rclpy.Context()
+        rclpy.init(args=['--ros-args', '--params-file', str(path)], context=context)
+        try:
+            with pytest.raises(ConfigError, match=needle) as info:
+                Compensator(context=context)
+            assert '\n' not in str(info.value)
+        finally:
+            context.try_shutdown()
+
+
+def test_node_main_reports_bad_input_in_one_line(ros_domain, tmp_path, capfd):
+    from hyst_id.nodes import replay
+    assert replay.main(['--ros-args', '-p', f'bag:={tmp_path / "missing"}']) == 2
+    junk = tmp_path / 'junk.mcap'
+    junk.write_bytes(b'not a bag at all')
+    assert replay.main(['--ros-args', '-p', f'bag:={junk}']) == 2
+    err = capfd.readouterr()
+    text = err.out + err.err
+    assert 'Traceback' not in text
+    assert 'no such file' in text and 'cannot read bag' in text
+
+
+# ------------------------------------------------------------------ compensator
+def test_compensator_swaps_valid_sets_and_keeps_the_last_good(ctx):
+    comp = _make(ctx, Compensator)
+    assert _set(comp, **PAPER).successful
+    good = comp.model
+    assert good is not None and good.hysteresis[0] == PAPER['m_l']
+    out = comp.step(9.5)
+    assert 4.0 <= out <= 20.0 and out != 9.5
+    bad = _set(comp, **{**PAPER, 'c_l': 0.9, 'c_r': 0.5})
+    assert not bad.successful and 'keeping the last good set' in bad.reason
+    assert comp.model is good
+    partial = _set(comp, m_l=math.nan)
+    assert not partial.successful and 'incomplete' in partial.reason
+    assert comp.model is good
+    assert _set(comp, **{**PAPER, 'c_r': 0.6}).successful
+    assert comp.model is not good and comp.model.hysteresis[5] == 0.6
+    assert _set(comp, max_command=9.2).successful
+    assert comp.step(15.0) <= 9.2
+    assert _set(comp, **{n: math.nan for n in COMPENSATOR_NAMES}).successful
+    assert comp.model is None
+    assert comp.step(9.1) == 9.1
+
+
+def test_compensator_incomplete_set_from_pass_through_is_accepted(ctx):
+    comp = _make(ctx, Compensator)
+    assert _set(comp, m_l=1.0).successful        # building a set one value at a time
+    assert comp.model is None
+    rest = {k: v for k, v in PAPER.items() if k != 'm_l'}
+    assert _set(comp, **rest).successful
+    assert comp.model is not None
+
+
+def test_compensator_follows_the_latched_identified_params(ctx):
+    comp = _make(ctx, Compensator)
+    talker = _make(ctx, Node, 'talker')
+    pub = talker.create_publisher(String, '/hyst_id/identified_params', LATCHED_QOS)
+    pub.publish(String(data='{not json'))
+    pub.publish(String(data=json.dumps({'channel': 'flow', 'params': PAPER})))
+    assert not _spin_until(ctx, [comp, talker], lambda: comp.model is not None, timeout=1.5)
+    bad = {**PAPER, 'c_l': 0.9}
+    pub.publish(String(data=json.dumps({'channel': 'position', 'params': bad})))
+    assert not _spin_until(ctx, [comp, talker], lambda: comp.model is not None, timeout=1.0)
+    pub.publish(String(data=json.dumps({'channel': 'position', 'params': bad,
+                                        'compensator_params': PAPER, 'er_percent': 1.5})))
+    assert _spin_until(ctx, [comp, talker], lambda: comp.model is not None)
+    assert comp.p('m_l') == PAPER['m_l'] and comp.p('er_percent') == 1.5
+
+
+def test_compensator_inverts_the_simulated_actuator(ctx):
+    comp = _make(ctx, Compensator)
+    assert _set(comp, **PAPER).successful
+    act = SimulatedActuator(PAPER_HYSTERESIS, {'m_bl': 1.0, 'c_bl': -0.25, 'c_br': 0.25})
+    t = np.arange(0, 60, 0.5)
+    desired = 9.0 + np.sin(2 * np.pi * t / 12.0)
+    act.apply(comp.step(desired[0]))
+    out = np.array([act.apply(comp.step(d)) for d in desired])
+    plain = SimulatedActuator(PAPER_HYSTERESIS, {'m_bl': 1.0, 'c_bl': -0.25, 'c_br': 0.25})
+    raw = np.array([plain.apply(d) for d in desired])
+    assert control_error_percent(out[10:], desired[10:]) < 1e-6
+    assert control_error_percent(raw, desired) > 1.0
+
+
+# ------------------------------------------------------------------ core of the nodes
+def test_simulated_actuator_matches_the_chain():
+    t = np.arange(0, 50, 0.1)
+    v = eq24(t)
+    act = SimulatedActuator(noise_std=0.0)
+    y = np.array([act.apply(x) for x in v])
+    x = np.array(list(PAPER_HYSTERESIS.values()) + list(PAPER_BACKLASH.values()))
+    np.testing.assert_allclose(y, chain_spec('position').simulate(x, t, v), atol=1e-12)
+
+
+def test_pair_streams_pairs_like_the_bag_reader(tmp_path):
+    rng = np.random.default_rng(3)
+    t = np.arange(200) * 0.05
+    cmd = 9 + 2 * np.sin(t)
+    meas = cmd * 0.5 + rng.normal(0, 0.01, t.size)
+    rec = Recording(t, cmd, meas, 'position')
+    bag = write_recording_bag(tmp_path / 'b', rec)
+    from hyst_id.io.readers import read_recording
+    read = read_recording(bag, 'position')
+    cmd_ns = [], []
+    meas_ns = [], []
+    for topic, _, t_ns, msg in iter_bag_messages(bag):
+        if topic == '/hyst_id/command':
+            cmd_ns[0].append(t_ns)
+            cmd_ns[1].append(msg.data)
+        else:
+            meas_ns[0].append(msg.header.stamp.sec * 10**9 + msg.header.stamp.nanosec)
+            meas_ns[1].append(msg.position[0])
+    live = pair_streams(np.array(cmd_ns[0]), np.array(cmd_ns[1]), np.array(meas_ns[0]),
+                        np.array(meas_ns[1]), 'position')
+    np.testing.assert_array_equal(live.command, read.command)
+    np.testing.assert_array_equal(live.measurement, read.measurement)
+    np.testing.assert_array_equal(live.t_s, read.t_s)
+    # a measurement before the first command is dropped; the last command <= stamp wins
+    r = pair_streams(np.array([10, 20, 30]), np.array([1.0, 2.0, 3.0]),
+                     np.array([5, 10, 25, 40, 40]), np.array([0.0, 1.0, 2.5, 3.5, 3.6]),
+                     'position')
+    np.testing.assert_array_equal(r.command, [1.0, 2.0, 3.0])
+    np.testing.assert_array_equal(r.measurement, [1.0, 2.5, 3.6])
+
+
+def test_params_file_round_trip_and_errors(tmp_path):
+    values = {'channel': 'pressure', 'params': dict(PAPER), 'er_percent': 2.5,
+              'output_sign': -1.0}
+    path = write_compensator_params(values, tmp_path / 'sub' / 'c.yaml')
+    back = read_compensator_params(path)
+    assert back['channel'] == 'pressure' and back['output_sign'] == -1.0
+    assert all(back[n] == PAPER[n] for n in COMPENSATOR_NAMES) and back['er_percent'] == 2.5
+    assert 'm_bl: 1.0\n' in path.read_text()       # doubles stay doubles for ROS
+    with pytest.raises(ConfigError, match='missing compensator parameters: m_l'):
+        write_compensator_params({k: v for k, v in PAPER.items() if k != 'm_l'}, path)
+    with pytest.raises(ConfigError, match='no such file'):
+        read_compensator_params(tmp_path / 'none.yaml')
+    (tmp_path / 'bad.yaml').write_text('compensator: [1, 2')
+    with pytest.raises(ConfigError, match='not valid YAML'):
+        read_compensator_params(tmp_path / 'bad.yaml')
+
+
+# ------------------------------------------------------------------ identifier
+def _feed(ident: Identifier, n: int = 400, dt_ns: int = 50_000_000) -> Recording:
+    t = np.arange(n) * dt_ns * 1e-9
+    v = eq24(t)
+    x = np.array(list(PAPER.values()))
+    y = chain_spec('position').simulate(x, t, v)
+    y = y + np.random.default_rng(0).normal(0, 0.005, n)
+    t0 = 1_800_000_000 * 10**9
+    for k in range(n):
+        ident.buffer.add_command(t0 + k * dt_ns, v[k])
+        ident.buffer.add_measurement(t0 + k * dt_ns + 1000, y[k])
+    return Recording(t, v, y, 'position')
+
+
+def test_identifier_identify_now_publishes_writes_and_matches_identify(ctx, tmp_path):
+    out = tmp_path / 'comp.yaml'
+    ident = _make(ctx, Identifier, parameter_overrides=[
+        Parameter('seeds', value=2), Parameter('generations', value=40),
+        Parameter('domains', value='paper'), Parameter('params_out', value=str(out)),
+        Parameter('end_of_run_timeout_s', value=0.0)])
+    got = []
+    listener = _make(ctx, Node, 'listener')
+    listener.create_subscription(String, '/hyst_id/identified_params',
+                                 lambda m: got.append(json.loads(m.data)), LATCHED_QOS)
+    rec = _feed(ident)
+    assert _set(ident, identify_now=True).successful
+    assert _spin_until(ctx, [ident, listener], lambda: bool(got), timeout=120.0)
+    doc = got[-1]
+    assert doc['channel'] == 'position' and doc['n_samples'] == rec.n_samples
+    assert doc['er_percent'] < 1.0
+    assert ident.p('identify_now') is False
+    assert read_compensator_params(out)['m_l'] == doc['compensator_params']['m_l']
+    ref = identify(rec, settings=ident.settings(), spec=chain_spec('position'))
+    assert ref.params == doc['params']
+
+
+def test_identifier_refuses_with_a_reason(ctx):
+    ident = _make(ctx, Identifier)
+    ok, message = ident.request_identification('test')
+    assert not ok and 'only 0 samples' in message
+    t0 = 10**18
+    for k in range(100):                        # constant command: nothing excited
+        ident.buffer.add_command(t0 + k * 10**7, 9.0)
+        ident.buffer.add_measurement(t0 + k * 10**7 + 1, 9.0)
+    ok, message = ident.request_identification('test')
+    assert not ok and 'constant' in message
+    assert ident.last_error
+
+
+def test_identifier_trigger_service(ctx):
+    pytest.importorskip('std_srvs')
+    from std_srvs.srv import Trigger
+    ident = _make(ctx, Identifier)
+    client_node = _make(ctx, Node, 'caller')
+    client = client_node.create_client(Trigger, '/identifier/identify')
+    assert _spin_until(ctx, [ident, client_node], client.service_is_ready, timeout=5.0)
+    future = client.call_async(Trigger.Request())
+    assert _spin_until(ctx, [ident, client_node], future.done, timeout=5.0)
+    assert not future.result().success and 'samples' in future.result().message
+
+
+# ------------------------------------------------------------------ I/O nodes
+def test_excitation_publishes_the_profile_samples(ctx):
+    exc = _make(ctx, Excitation, parameter_overrides=[
+        Parameter('duration_s', value=2.0), Parameter('time_scale', value=100.0),
+        Parameter('wait_for_subscribers', value=1)])
+    got = []
+    sink = _make(ctx, Node, 'sink')
+    sink.create_subscription(Float64, '/hyst_id/command', lambda m: got.append(m.data), 100)
+    assert _spin_until(ctx, [exc, sink], lambda: exc.finished and len(got) == 21)
+    np.testing.assert_allclose(got, eq24(np.arange(21) * 0.1), rtol=0, atol=1e-15)
+
+
+def test_recorder_writes_a_readable_bag(ctx, tmp_path):
+    rec = _make(ctx, Recorder, parameter_overrides=[
+        Parameter('output', value=str(tmp_path / 'bag')),
+        Parameter('topics', value=['/hyst_id/command', '/hyst_id/position'])])
+    talker = _make(ctx, Node, 'talker')
+    pub = talker.create_publisher(Float64, '/hyst_id/command', 100)
+    assert _spin_until(ctx, [rec, talker], lambda: '/hyst_id/command' in rec.subscribed)
+    assert _spin_until(ctx, [rec, talker], lambda: pub.get_subscription_count() > 0)
+    for k in range(20):
+        pub.publish(Float64(data=float(k)))
+    assert _spin_until(ctx, [rec, talker], lambda: rec.counts['/hyst_id/command'] == 20)
+    rec.close()
+    rows = list(iter_bag_messages(tmp_path / 'bag'))
+    assert [m.data for _, _, _, m in rows] == [float(k) for k in range(20)]
+    assert (tmp_path / 'bag' / 'metadata.yaml').exists()
+    with pytest.raises(RecordingError, match='cannot create bag'):
+        Recorder(context=ctx[0], parameter_overrides=[
+            Parameter('output', value=str(tmp_path / 'bag'))])
+
+
+def test_control_error_percent_is_eq26():
+    assert control_error_percent([1.0, 2.0], [1.0, 2.0]) == 0.0
+    assert control_error_percent([1.1, 2.0], [1.0, 2.0]) == pytest.approx(
+        100 * math.sqrt(0.01 / 5.0))

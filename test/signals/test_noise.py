@@ -1,0 +1,59 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""The model-free noise estimate behind the noise floor."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from hyst_id.rig import load_rig_params, simulate_rig
+from hyst_id.signals.excitation import eq24
+from hyst_id.signals.noise import estimate_noise_std, noise_floor_percent
+
+PIPELINE = Path(__file__).resolve().parents[2] / 'params' / 'pipeline.yaml'
+
+
+@pytest.mark.parametrize('sigma', [0.01, 0.1, 1.0])
+def test_white_noise_on_a_smooth_signal(sigma):
+    t = np.arange(0, 100, 0.05)
+    clean = 10 + 3 * np.sin(2 * np.pi * t / 10)
+    y = clean + np.random.default_rng(0).normal(0, sigma, t.size)
+    assert estimate_noise_std(y) == pytest.approx(sigma, rel=0.06)
+
+
+def test_quantised_noise_is_not_underestimated():
+    """12-bit A/D steps comparable to the noise: a MAD would read ~30 % low."""
+    t = np.arange(0, 100, 0.05)
+    clean = 9 + 2 * np.sin(2 * np.pi * t / 10)
+    q = 16.0 / 4096
+    y = np.round((clean + np.random.default_rng(1).normal(0, 0.005, t.size)) / q) * q
+    true = np.std(y - clean)
+    assert estimate_noise_std(y) == pytest.approx(true, rel=0.08)
+
+
+def test_rig_channels_match_their_known_noise():
+    t = np.arange(0, 100, 0.05)
+    run = simulate_rig(load_rig_params(PIPELINE), t, eq24(t), seed=0)
+    for channel, clean in (('position', 'position_clean'), ('flow', 'flow_clean_g_s')):
+        y = run.recording(channel).measurement
+        assert estimate_noise_std(y) == pytest.approx(np.std(y - run.truth[clean]), rel=0.1)
+
+
+def test_floor_from_known_noise():
+    y = np.full(400, 10.0)
+    assert noise_floor_percent(y, noise_std=0.1) == pytest.approx(1.0)
