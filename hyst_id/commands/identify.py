@@ -63,7 +63,7 @@ def run(args: argparse.Namespace) -> int:
         for path in plot_identification(ident, rec, args.plot):
             print(f'wrote {path}', file=sys.stderr)
     if args.params_out:
-        from hyst_id.io.params_file import write_compensator_params
+        from hyst_id.compensation.params_file import write_compensator_params
         write_compensator_params(ident, args.params_out)
         print(f'wrote {args.params_out}', file=sys.stderr)
     return 0

@@ -23,4 +23,4 @@ May import: :mod:`hyst_id.models`, :mod:`hyst_id.errors`.
 
 from hyst_id.compensation.inverse import CommandLimits, Compensator, InverseModel
 
-__all__ = [CommandLimits, Compensator, InverseModel]
+__all__ = ['CommandLimits', 'Compensator', 'InverseModel']

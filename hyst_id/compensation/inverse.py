@@ -18,14 +18,15 @@ The :class:`Compensator` keeps its own copy of the model state (last command
 ``v``, hysteresis output ``u`` and backlash output ``y``) and advances it
 with the command it actually emits, after command limits, so the model
 never drifts from what the actuator was sent. Parameters are in the
-canonical gauge (:mod:`hyst_id.identification.gauge`): the hysteresis output is in the
-measurement's units and the backlash has unit slope, so the desired value
-is given in the measured channel's units. Sensor dynamics are not inverted
-(as in the paper).
+canonical gauge (:mod:`hyst_id.identification.gauge`): the hysteresis output
+is in the measurement's units and the backlash has unit slope, so the
+desired value is given in the measured channel's units. Sensor dynamics are
+not inverted (as in the paper). H is any registered hysteresis family
+(:mod:`hyst_id.models.registry`); each brings its exact inverse.
 
 Parameter sets are immutable :class:`InverseModel` objects: swapping one in
-is a single reference assignment, so an update applies atomically between
-two samples.
+is a single reference assignment (model and inverse state together), so an
+update applies atomically between two samples.
 """
 
 from __future__ import annotations
@@ -36,15 +37,15 @@ from typing import Mapping
 
 import numpy as np
 
-from hyst_id.errors import InvalidParametersError
-from hyst_id.models.backlash import backlash_inverse_step, backlash_step, check_backlash
-from hyst_id.models.tk import (
-    check_hysteresis,
-    hysteresis_inverse_step,
-    HYSTERESIS_NAMES,
-    hysteresis_step,
-    initial_output,
+from hyst_id.errors import ConfigError, InvalidParametersError
+from hyst_id.models.backlash import (
+    backlash_inverse_step,
+    BACKLASH_NAMES,
+    backlash_step,
+    check_backlash,
 )
+from hyst_id.models.family import HysteresisFamily, HysteresisInverse
+from hyst_id.models.registry import DEFAULT_FAMILY, get_family
 
 __all__ = ['InverseModel', 'CommandLimits', 'Compensator']
 
@@ -55,46 +56,78 @@ class InverseModel:
 
     ``output_sign`` is the canonical calibration gain: -1 when the measured
     channel falls as the actuator output rises (the model then works on the
-    negated measurement).
+    negated measurement). ``family`` is H's family id (``tk``: the paper's).
     """
 
     hysteresis: tuple[float, ...]
     backlash: tuple[float, float, float]
     output_sign: float = 1.0
+    family: str = DEFAULT_FAMILY
+
+    @property
+    def h_family(self) -> HysteresisFamily:
+        """H's family object."""
+        return get_family(self.family)
 
     @classmethod
-    def from_mapping(cls, values: Mapping[str, float]) -> 'InverseModel':
-        """Build from ``m_l ... c_b, m_bl, c_bl, c_br``; raise InvalidParametersError."""
-        missing = [n for n in HYSTERESIS_NAMES + ('m_bl', 'c_bl', 'c_br') if n not in values]
+    def names(cls, family: str | None = None) -> tuple[str, ...]:
+        """Parameter names of a set: H's (per family), then the backlash's."""
+        return tuple(get_family(family).names) + BACKLASH_NAMES
+
+    @classmethod
+    def from_mapping(cls, values: Mapping[str, float]) -> InverseModel:
+        """Build from ``family`` (default tk), H's names, ``m_bl, c_bl, c_br``, ``output_sign``.
+
+        Raises
+        ------
+        InvalidParametersError
+            Unknown family, missing or non-numeric values, a set the family refuses.
+        """
+        try:
+            family = get_family(str(values.get('family', DEFAULT_FAMILY)))
+        except ConfigError as exc:
+            raise InvalidParametersError(str(exc)) from None
+        names = tuple(family.names) + BACKLASH_NAMES
+        missing = [n for n in names if n not in values]
         if missing:
             raise InvalidParametersError(f'missing parameters: {", ".join(missing)}')
         try:
-            h = check_hysteresis([float(values[n]) for n in HYSTERESIS_NAMES])
-            b = check_backlash([float(values[n]) for n in ('m_bl', 'c_bl', 'c_br')])
+            h = family.check([float(values[n]) for n in family.names])
+            b = check_backlash([float(values[n]) for n in BACKLASH_NAMES])
             sign = float(values.get('output_sign', 1.0))
         except (TypeError, ValueError) as exc:
             raise InvalidParametersError(f'parameters must be numbers: {exc}') from None
         if sign not in (1.0, -1.0):
             raise InvalidParametersError(f'output_sign must be +1 or -1, got {sign}')
-        return cls(tuple(float(x) for x in h), (float(b[0]), float(b[1]), float(b[2])), sign)
+        return cls(tuple(float(x) for x in h), (float(b[0]), float(b[1]), float(b[2])), sign,
+                   family.id)
 
     @classmethod
-    def from_vector(cls, params: np.ndarray, output_sign: float = 1.0) -> 'InverseModel':
-        """Build from a chain vector (first 11 entries: H then B)."""
+    def from_vector(cls, params: np.ndarray, output_sign: float = 1.0,
+                    family: str | None = None) -> InverseModel:
+        """Build from a chain vector (H's parameters, then B's; sensor ones ignored)."""
+        fam = get_family(family)
+        nh = fam.n_params
         p = np.asarray(params, dtype=float).ravel()
-        if p.shape[0] < 11:
-            raise InvalidParametersError('need at least 11 parameters (H and B)')
+        if p.shape[0] < nh + 3:
+            raise InvalidParametersError(f'need at least {nh + 3} parameters (H and B)')
         if output_sign not in (1.0, -1.0):
             raise InvalidParametersError(f'output_sign must be +1 or -1, got {output_sign}')
-        return cls(tuple(float(x) for x in check_hysteresis(p[:8])),
-                   tuple(float(x) for x in check_backlash(p[8:11])), float(output_sign))
+        return cls(tuple(float(x) for x in fam.check(p[:nh])),
+                   tuple(float(x) for x in check_backlash(p[nh:nh + 3])), float(output_sign),
+                   fam.id)
 
-    def output_range(self, v: float) -> tuple[float, float]:
-        """Lowest and highest H output reachable at command ``v`` (loop boundaries)."""
-        m_l, m_r, m_t, m_b, c_l, c_r, c_t, c_b = self.hysteresis
-        lower = initial_output(v, m_r, m_t, m_b, c_r, c_t, c_b)
-        upper = max(min(m_t * v + c_t, m_l * (v - c_l)), m_b * v + c_b)
-        return lower, upper
+    def as_mapping(self) -> dict[str, float | str]:
+        """Name -> value (with ``family`` and ``output_sign``), as params files hold them."""
+        out: dict[str, float | str] = dict(zip(self.names(self.family),
+                                               self.hysteresis + self.backlash))
+        out['output_sign'] = self.output_sign
+        out['family'] = self.family
+        return out
+
+    def inverse(self) -> HysteresisInverse:
+        """A fresh inverse of H with its own state."""
+        return self.h_family.inverse(np.asarray(self.hysteresis, dtype=float))
 
 
 @dataclass(frozen=True)
@@ -128,14 +161,14 @@ class Compensator:
     def __init__(self, model: InverseModel | None, limits: CommandLimits | None = None,
                  v0: float = 0.0) -> None:
         self.limits = limits or CommandLimits()
-        self._model = model
+        self._active: tuple[InverseModel | None, HysteresisInverse | None] = (model, None)
         self._t_prev: float | None = None
         self.reset(v0)
 
     @property
     def model(self) -> InverseModel | None:
         """The parameter set in use (``None``: pass-through)."""
-        return self._model
+        return self._active[0]
 
     @property
     def state(self) -> tuple[float, float, float]:
@@ -146,13 +179,17 @@ class Compensator:
         """Put the model state on the rising boundary at command ``v0``."""
         self._v = float(v0)
         self._t_prev = None
-        if self._model is None:
+        model = self._active[0]
+        if model is None:
             self._u = self._y = float(v0)
+            self._active = (None, None)
             return
-        m_l, m_r, m_t, m_b, c_l, c_r, c_t, c_b = self._model.hysteresis
-        m_bl, c_bl, c_br = self._model.backlash
-        self._u = initial_output(self._v, m_r, m_t, m_b, c_r, c_t, c_b)
+        inv = model.inverse()
+        inv.reset(self._v)
+        self._u = inv.output
+        m_bl, c_bl, c_br = model.backlash
         self._y = m_bl * (self._u - c_br)
+        self._active = (model, inv)
 
     def set_model(self, model: InverseModel | None) -> None:
         """Swap the parameter set between samples, keeping a consistent state.
@@ -160,12 +197,15 @@ class Compensator:
         The current command is kept; the hysteresis and backlash outputs are
         projected into the new model's loop at that command.
         """
-        if model is not None:
-            lower, upper = model.output_range(self._v)
-            self._u = min(max(self._u, lower), upper)
-            m_bl, c_bl, c_br = model.backlash
-            self._y = min(max(self._y, m_bl * (self._u - c_br)), m_bl * (self._u - c_bl))
-        self._model = model
+        if model is None:
+            self._active = (None, None)
+            return
+        inv = model.inverse()
+        inv.reset(self._v, self._u)
+        self._u = inv.output
+        m_bl, c_bl, c_br = model.backlash
+        self._y = min(max(self._y, m_bl * (self._u - c_br)), m_bl * (self._u - c_bl))
+        self._active = (model, inv)
 
     def step(self, desired: float, t_s: float | None = None) -> float:
         """Command for one desired output sample.
@@ -182,20 +222,17 @@ class Compensator:
         float
             Command to send to the actuator (within the limits).
         """
-        model = self._model
+        model, inv = self._active
         if model is None:
             v = float(desired)
         else:
-            m_l, m_r, m_t, m_b, c_l, c_r, c_t, c_b = model.hysteresis
             m_bl, c_bl, c_br = model.backlash
             target = model.output_sign * desired
             u_d = backlash_inverse_step(target, self._y, self._u, m_bl, c_bl, c_br)
-            v = hysteresis_inverse_step(u_d, self._v, self._u,
-                                        m_l, m_r, m_t, m_b, c_l, c_r, c_t, c_b)
+            v = inv.command_for(u_d)
         v = self._limit(v, t_s)
         if model is not None:
-            self._u = hysteresis_step(v, self._v, self._u, m_l, m_r, m_t, m_b, c_l, c_r,
-                                      c_t, c_b)
+            self._u = inv.advance(v)
             self._y = backlash_step(self._u, self._y, m_bl, c_bl, c_br)
         self._v = v
         return v

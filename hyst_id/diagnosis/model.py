@@ -17,7 +17,7 @@
 ``v -> [command] -> H -> B -> [position] -> [quantity] -> sensor -> [sensor]
 -> (linear calibration + [output] regressors) -> y``
 
-The parameter vector is the chain's own (:data:`hyst_id.identification.chains.CHAIN_NAMES`,
+The parameter vector is the chain's own (:meth:`hyst_id.identification.chains.ChainSpec.names`,
 in the chain's search space) followed by each mechanism's searched
 parameters. Everything that enters linearly (the affine calibration ``k,
 b``, the static nonlinearity's polynomial terms, the drift rate, the
@@ -33,12 +33,10 @@ from typing import Sequence
 import numpy as np
 
 from hyst_id.diagnosis.mechanisms.base import Context, Mechanism, STAGES
-from hyst_id.identification.chains import CHAIN_NAMES, chain_spec
+from hyst_id.identification.chains import chain_spec
 from hyst_id.models.sensors import simulate_first_order, simulate_second_order
 
 __all__ = ['ComposedModel', 'Evaluation', 'solve_linear']
-
-_POSITION_SPEC = chain_spec('position')
 
 
 class Evaluation:
@@ -72,15 +70,18 @@ class ComposedModel:
         Recording facts the blocks need.
     chain_bounds : numpy.ndarray
         ``(n_chain, 2)`` bounds of the chain's parameters.
+    family : str, optional
+        H's family (default the paper's ``tk``).
     """
 
     def __init__(self, channel: str, mechanisms: Sequence[Mechanism], ctx: Context,
-                 chain_bounds: np.ndarray) -> None:
+                 chain_bounds: np.ndarray, family: str | None = None) -> None:
         self.channel = channel
         self.ctx = ctx
         self.mechanisms = tuple(sorted(mechanisms, key=lambda m: STAGES.index(m.stage)))
-        self.spec = chain_spec(channel)
-        self.n_chain = len(CHAIN_NAMES[channel])
+        self.spec = chain_spec(channel, family=family)
+        self.position_spec = chain_spec('position', family=family)
+        self.n_chain = self.spec.n_params
         bounds = [np.asarray(chain_bounds, dtype=float)]
         self.slices: dict[str, slice] = {}
         k = self.n_chain
@@ -146,7 +147,7 @@ class ComposedModel:
             if m.stage == 'actuator':
                 x = m.actuator(th[m.id], x_chain, t_s, vv)
         if x is None:
-            x = _POSITION_SPEC.signal(x_chain[:11], t_s, vv)
+            x = self.position_spec.signal(x_chain[:self.spec.sensor_slice.start], t_s, vv)
         seg = x[:max(2, n_span)]
         lo, hi = float(np.min(seg)), float(np.max(seg))
         if not hi > lo:
@@ -177,10 +178,11 @@ class ComposedModel:
         return Evaluation(columns, labels, span, travel_raw)
 
     def _sensor(self, x_chain: np.ndarray, t_s: np.ndarray, s: np.ndarray) -> np.ndarray:
+        sensor = x_chain[self.spec.sensor_slice]
         if self.channel == 'pressure':
-            return simulate_first_order(s, t_s, float(x_chain[11]))
+            return simulate_first_order(s, t_s, float(sensor[0]))
         if self.channel == 'flow':
-            return simulate_second_order(s, t_s, float(x_chain[11]), float(x_chain[12]))
+            return simulate_second_order(s, t_s, float(sensor[0]), float(sensor[1]))
         return s
 
 

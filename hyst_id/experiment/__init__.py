@@ -25,4 +25,4 @@ May import: everything below it (:mod:`hyst_id.rig`, :mod:`hyst_id.identificatio
 from hyst_id.experiment.result import CHANNELS, ExperimentConfig, ExperimentResult, MODES
 from hyst_id.experiment.run import run_experiment
 
-__all__ = [CHANNELS, MODES, ExperimentConfig, ExperimentResult, run_experiment]
+__all__ = ['CHANNELS', 'MODES', 'ExperimentConfig', 'ExperimentResult', 'run_experiment']

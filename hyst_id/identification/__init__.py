@@ -36,4 +36,4 @@ May import: :mod:`hyst_id.signals`, :mod:`hyst_id.io`, :mod:`hyst_id.models`,
 from hyst_id.identification.driver import identify, run_seed
 from hyst_id.identification.result import Identification, IdentifySettings, SeedRun
 
-__all__ = [identify, run_seed, Identification, IdentifySettings, SeedRun]
+__all__ = ['identify', 'run_seed', 'Identification', 'IdentifySettings', 'SeedRun']

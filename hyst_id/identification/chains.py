@@ -12,30 +12,34 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
-"""The actuator chains of the paper's Fig. 1, one per measured channel.
+"""The actuator chains of the paper's Fig. 1, one per measured channel and hysteresis family.
 
 ``v -> H -> B -> sensor -> calibration -> y``
 
-=========  ==========================================  ===========
-channel    parameters (in vector order)                count
-=========  ==========================================  ===========
-position   m_l m_r m_t m_b c_l c_r c_t c_b m_bl c_bl c_br   11
-pressure   ... + tau_s (first-order sensor)                 12
-flow       ... + zeta omega_n (second-order sensor)         13
-=========  ==========================================  ===========
+=========  =================================================  =========================
+channel    parameters (in vector order)                       count with the ``tk`` H
+=========  =================================================  =========================
+position   H's (``tk``: m_l m_r m_t m_b c_l c_r c_t c_b),     11
+           then m_bl c_bl c_br
+pressure   ... + tau_s (first-order sensor)                   12
+flow       ... + zeta omega_n (second-order sensor)           13
+=========  =================================================  =========================
 
-Measurements arrive in the sensor's own units (mm, kPa, psi, g/s), so an
-affine calibration ``y = k s + b`` follows the sensor dynamics. By default
-``k`` and ``b`` are *profiled out*: for every candidate the best ``(k, b)`` is
-the closed-form linear least-squares fit, so the optimiser searches only the
-physical parameters and the calibration is always exact for the candidate
-(variable projection). A fixed calibration can be given instead (the
-paper's position chain is ``k = 1, b = 0``). Results are reported in the
-canonical gauge (:mod:`hyst_id.identification.gauge`), where the calibration is ``(1, 0)``.
+H is any registered hysteresis family (:mod:`hyst_id.models.registry`; the
+paper's ``tk`` by default). Measurements arrive in the sensor's own units
+(mm, kPa, psi, g/s), so an affine calibration ``y = k s + b`` follows the
+sensor dynamics. By default ``k`` and ``b`` are *profiled out*: for every
+candidate the best ``(k, b)`` is the closed-form linear least-squares fit, so
+the optimiser searches only the physical parameters and the calibration is
+always exact for the candidate (variable projection). A fixed calibration
+can be given instead (the paper's position chain is ``k = 1, b = 0``).
+Results are reported in the canonical gauge (:mod:`hyst_id.identification.gauge`),
+where the calibration is ``(1, 0)``.
 
-The population kernel :func:`population_cost` simulates the chain for a
-whole population and returns the paper's cost J (Eq. 6) per candidate with
-no Python in the per-sample loop.
+The population cost (:meth:`ChainSpec.cost_function`) runs in two numba
+passes per block of candidates: the family's kernel writes H's output, then
+:func:`_tail_costs` runs backlash, sensor and calibration and returns the
+paper's cost J (Eq. 6); no Python runs per sample.
 """
 
 from __future__ import annotations
@@ -48,95 +52,96 @@ import numpy as np
 
 from hyst_id.errors import ConfigError, InvalidParametersError
 from hyst_id.models.backlash import BACKLASH_NAMES, backlash_step, check_backlash
+from hyst_id.models.family import HysteresisFamily
+from hyst_id.models.registry import DEFAULT_FAMILY, get_family
 from hyst_id.models.sensors import first_order_coefficient, second_order_coefficients
-from hyst_id.models.tk import (
-    check_hysteresis,
-    hysteresis_feasible,
-    HYSTERESIS_NAMES,
-    hysteresis_step,
-    initial_output,
-)
 
 __all__ = [
     'CHAIN_NAMES',
+    'CHANNELS',
     'PAPER_DOMAINS',
     'PARAM_UNITS',
+    'SENSOR_NAMES',
     'ChainSpec',
+    'chain_names',
     'chain_spec',
-    'population_cost',
     'er_percent',
+    'param_units',
 ]
 
+CHANNELS = ('position', 'pressure', 'flow')
+#: Sensor-dynamics parameters of each channel.
 SENSOR_NAMES = {'position': (), 'pressure': ('tau_s',), 'flow': ('zeta', 'omega_n')}
-CHAIN_NAMES = {ch: HYSTERESIS_NAMES + BACKLASH_NAMES + extra
-               for ch, extra in SENSOR_NAMES.items()}
 _KIND = {'position': 0, 'pressure': 1, 'flow': 2}
 
-#: Units of each parameter; ``cmd`` is the command's unit (mA on the paper's
-#: rig) and ``out`` the hysteresis output's unit (position units).
-PARAM_UNITS = {
-    'm_l': 'out/cmd', 'm_r': 'out/cmd', 'm_t': 'out/cmd', 'm_b': 'out/cmd',
-    'c_l': 'cmd', 'c_r': 'cmd', 'c_t': 'out', 'c_b': 'out',
-    'm_bl': '1', 'c_bl': 'out', 'c_br': 'out',
-    'tau_s': 's', 'zeta': '1', 'omega_n': 'rad/s',
-}
+#: Units of the parameters that do not belong to H.
+TAIL_UNITS = {'m_bl': '1', 'c_bl': 'out', 'c_br': 'out', 'tau_s': 's', 'zeta': '1',
+              'omega_n': 'rad/s'}
+#: Search domains of the backlash and sensors in the paper (section 4).
+TAIL_PAPER_DOMAINS = {'m_bl': (0.0, 10.0), 'c_bl': (-10.0, 10.0), 'c_br': (-10.0, 10.0),
+                      'tau_s': (0.0, 20.0), 'zeta': (0.0, 0.99), 'omega_n': (0.0, 10.0)}
 
-#: The paper's search domains (section 4), a named preset.
-PAPER_DOMAINS = {
-    'm_l': (0.0, 5.0), 'm_r': (0.0, 5.0), 'm_t': (0.0, 5.0), 'm_b': (0.0, 5.0),
-    'c_l': (-5.0, 5.0), 'c_r': (-5.0, 5.0), 'c_t': (4.0, 20.0), 'c_b': (4.0, 20.0),
-    'm_bl': (0.0, 10.0), 'c_bl': (-10.0, 10.0), 'c_br': (-10.0, 10.0),
-    'tau_s': (0.0, 20.0), 'zeta': (0.0, 0.99), 'omega_n': (0.0, 10.0),
-}
+
+def chain_names(channel: str, family: str | HysteresisFamily | None = None) -> tuple[str, ...]:
+    """Parameter names of a channel's chain with a hysteresis family, in vector order."""
+    if channel not in SENSOR_NAMES:
+        raise ConfigError(f'unknown channel {channel!r}; expected one of {CHANNELS}')
+    return tuple(get_family(family).names) + BACKLASH_NAMES + SENSOR_NAMES[channel]
+
+
+def param_units(family: str | HysteresisFamily | None = None) -> dict[str, str]:
+    """Unit of every parameter of the chains with ``family`` (``cmd``, ``out``, ...)."""
+    return {**dict(get_family(family).units), **TAIL_UNITS}
+
+
+#: Names of the chains with the paper's ``tk`` loop, per channel.
+CHAIN_NAMES = {ch: chain_names(ch, DEFAULT_FAMILY) for ch in CHANNELS}
+#: Units of every parameter of the ``tk`` chains.
+PARAM_UNITS = param_units(DEFAULT_FAMILY)
+#: The paper's search domains (section 4), a named preset (``tk`` only).
+PAPER_DOMAINS = {**dict(get_family(DEFAULT_FAMILY).paper_domains), **TAIL_PAPER_DOMAINS}
 
 
 @njit(cache=True)
-def _feasible(p):
-    return (hysteresis_feasible(p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7])
-            and p[8] > 0.0 and p[9] < p[10])
-
-
-@njit(cache=True)
-def _feasible_rows(pop):
-    ok = np.empty(pop.shape[0], dtype=np.bool_)
-    for i in range(pop.shape[0]):
-        ok[i] = np.all(np.isfinite(pop[i])) and _feasible(pop[i])
+def _tail_feasible_rows(tail):
+    ok = np.empty(tail.shape[0], dtype=np.bool_)
+    for i in range(tail.shape[0]):
+        good = tail[i, 0] > 0.0 and tail[i, 1] < tail[i, 2]
+        for q in range(tail.shape[1]):
+            if not np.isfinite(tail[i, q]):
+                good = False
+        ok[i] = good
     return ok
 
 
 @njit(cache=True)
-def _chain_signal(p, kind, v, dt_s, uniform, out):
-    """Write the pre-calibration chain output for one candidate into ``out``."""
-    m_l, m_r, m_t, m_b, c_l, c_r, c_t, c_b = p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7]
-    m_bl, c_bl, c_br = p[8], p[9], p[10]
-    u = initial_output(v[0], m_r, m_t, m_b, c_r, c_t, c_b)
-    y = m_bl * (u - c_br)
+def _tail_signal(u, tail, kind, dt_s, uniform, out):
+    """Backlash and sensor dynamics after H's output ``u``, into ``out``."""
+    m_bl, c_bl, c_br = tail[0], tail[1], tail[2]
+    y = m_bl * (u[0] - c_br)
     out[0] = y
-    n = v.shape[0]
+    n = u.shape[0]
     if kind == 0:
         for j in range(1, n):
-            u = hysteresis_step(v[j], v[j - 1], u, m_l, m_r, m_t, m_b, c_l, c_r, c_t, c_b)
-            y = backlash_step(u, y, m_bl, c_bl, c_br)
+            y = backlash_step(u[j], y, m_bl, c_bl, c_br)
             out[j] = y
     elif kind == 1:
-        tau = p[11]
+        tau = tail[3]
         a = first_order_coefficient(dt_s[1], tau)
         x = y
         for j in range(1, n):
-            u = hysteresis_step(v[j], v[j - 1], u, m_l, m_r, m_t, m_b, c_l, c_r, c_t, c_b)
-            y = backlash_step(u, y, m_bl, c_bl, c_br)
+            y = backlash_step(u[j], y, m_bl, c_bl, c_br)
             if not uniform:
                 a = first_order_coefficient(dt_s[j], tau)
             x = a * x + (1.0 - a) * y
             out[j] = x
     else:
-        zeta, omega = p[11], p[12]
+        zeta, omega = tail[3], tail[4]
         p11, p12, p21, p22 = second_order_coefficients(dt_s[1], zeta, omega)
         x = y
         xd = 0.0
         for j in range(1, n):
-            u = hysteresis_step(v[j], v[j - 1], u, m_l, m_r, m_t, m_b, c_l, c_r, c_t, c_b)
-            y = backlash_step(u, y, m_bl, c_bl, c_br)
+            y = backlash_step(u[j], y, m_bl, c_bl, c_br)
             if not uniform:
                 p11, p12, p21, p22 = second_order_coefficients(dt_s[j], zeta, omega)
             e = x - y
@@ -147,7 +152,10 @@ def _chain_signal(p, kind, v, dt_s, uniform, out):
 
 @njit(cache=True)
 def _fit_affine(s, y):
-    """Least-squares ``(k, b)`` of ``y ~ k s + b`` and its residual sum of squares."""
+    """Least-squares ``(k, b)`` of ``y ~ k s + b`` and its residual sum of squares.
+
+    Sums in sample order (a fixed order: the same bits on every CPU make).
+    """
     n = s.shape[0]
     s_ref = s[0]
     ss = 0.0
@@ -182,53 +190,33 @@ def _sse(s, y, k, b):
 
 
 @njit(cache=True)
-def population_cost(pop, kind, v, y, dt_s, uniform, profile, k_fixed, b_fixed):
-    """Cost J (Eq. 6) of every row of ``pop``; infeasible rows cost ``inf``.
-
-    Parameters
-    ----------
-    pop : numpy.ndarray
-        ``(n_candidates, n_params)`` parameter vectors.
-    kind : int
-        0 position, 1 first-order sensor, 2 second-order sensor.
-    v, y, dt_s : numpy.ndarray
-        Command, measurement and sample intervals (seconds).
-    uniform : bool
-        All intervals equal (sensor coefficients computed once).
-    profile : bool
-        Fit the affine calibration per candidate (else use the fixed one).
-    k_fixed, b_fixed : float
-        The fixed calibration when ``profile`` is False.
-
-    Returns
-    -------
-    numpy.ndarray
-        J per candidate.
-    """
-    n_pop = pop.shape[0]
-    costs = np.empty(n_pop)
-    s = np.empty(v.shape[0])
-    for i in range(n_pop):
-        p = pop[i]
-        ok = _feasible(p)
-        for q in range(p.shape[0]):
-            if not np.isfinite(p[q]):
-                ok = False
-        if not ok:
+def _tail_costs(u, tail, ok, kind, y, dt_s, uniform, profile, k_fixed, b_fixed, costs):
+    """Cost J (Eq. 6) of every row whose H output is ``u[i]``; infeasible rows cost inf."""
+    s = np.empty(y.shape[0])
+    for i in range(u.shape[0]):
+        if not ok[i]:
             costs[i] = np.inf
             continue
-        _chain_signal(p, kind, v, dt_s, uniform, s)
+        _tail_signal(u[i], tail[i], kind, dt_s, uniform, s)
         if profile:
             k, b, _ = _fit_affine(s, y)
             costs[i] = _sse(s, y, k, b)   # second pass: no cancellation
         else:
             costs[i] = _sse(s, y, k_fixed, b_fixed)
-    return costs
 
 
 def er_percent(cost_j: float | np.ndarray, measurement: np.ndarray) -> float | np.ndarray:
     """Relative percentage error %e_r (Eq. 7) from the cost J."""
-    return np.sqrt(np.asarray(cost_j) / float(np.sum(np.square(measurement)))) * 100.0
+    y = np.ascontiguousarray(measurement, dtype=np.float64)
+    return np.sqrt(np.asarray(cost_j) / _sum_squares(y)) * 100.0
+
+
+@njit(cache=True)
+def _sum_squares(y):
+    acc = 0.0
+    for j in range(y.shape[0]):
+        acc += y[j] * y[j]
+    return acc
 
 
 def _intervals(t_s: np.ndarray) -> tuple[np.ndarray, bool]:
@@ -236,6 +224,10 @@ def _intervals(t_s: np.ndarray) -> tuple[np.ndarray, bool]:
     dt = np.ascontiguousarray(np.concatenate([d[:1], d]))
     uniform = bool(np.all(np.abs(d - d[0]) <= 1e-9 * abs(d[0])))
     return dt, uniform
+
+
+#: Largest number of H outputs (candidates x samples) held at once by the population cost.
+_BLOCK_VALUES = 262_144
 
 
 @dataclass(frozen=True)
@@ -250,6 +242,12 @@ class ChainSpec:
         ``(n_params, 2)`` search domain per parameter, in :attr:`names` order.
     calibration : tuple of float or None
         Fixed ``(k, b)`` of ``y = k s + b``; ``None`` profiles it per candidate.
+    domain_source : str
+        Where the bounds came from (``paper``, ``auto``, ``given``).
+    extra : dict
+        Scales of the data the domains were derived from.
+    family : HysteresisFamily
+        The hysteresis H (the paper's ``tk`` by default).
     """
 
     channel: str
@@ -257,16 +255,18 @@ class ChainSpec:
     calibration: tuple[float, float] | None = None
     domain_source: str = 'paper'
     extra: dict = field(default_factory=dict)
+    family: HysteresisFamily = field(default_factory=lambda: get_family(DEFAULT_FAMILY))
 
     @property
     def names(self) -> tuple[str, ...]:
         """Parameter names in vector order."""
-        return CHAIN_NAMES[self.channel]
+        return chain_names(self.channel, self.family)
 
     @property
     def units(self) -> tuple[str, ...]:
-        """Unit of each parameter (see :data:`PARAM_UNITS`)."""
-        return tuple(PARAM_UNITS[n] for n in self.names)
+        """Unit of each parameter (see :func:`param_units`)."""
+        units = param_units(self.family)
+        return tuple(units[n] for n in self.names)
 
     @property
     def n_params(self) -> int:
@@ -274,20 +274,37 @@ class ChainSpec:
         return len(self.names)
 
     @property
+    def n_h(self) -> int:
+        """Number of H's parameters (they come first)."""
+        return self.family.n_params
+
+    @property
+    def backlash_slice(self) -> slice:
+        """Where ``m_bl, c_bl, c_br`` sit in a parameter vector."""
+        return slice(self.n_h, self.n_h + 3)
+
+    @property
+    def sensor_slice(self) -> slice:
+        """Where the sensor's parameters sit (empty for position)."""
+        return slice(self.n_h + 3, self.n_params)
+
+    @property
     def profiled(self) -> bool:
         """Whether the affine calibration is fitted per candidate."""
         return self.calibration is None
 
     def with_bounds(self, bounds: Mapping[str, tuple[float, float]] | np.ndarray,
-                    source: str = 'given') -> 'ChainSpec':
+                    source: str = 'given') -> ChainSpec:
         """Return a copy with some or all search domains replaced."""
-        return replace(self, bounds=_bounds_array(self.channel, bounds, self.bounds),
+        return replace(self, bounds=_bounds_array(self.names, bounds, self.bounds, self.channel),
                        domain_source=source)
 
     def feasible(self, pop: np.ndarray) -> np.ndarray:
         """Boolean mask of the rows of ``pop`` that satisfy every constraint."""
         pop = np.ascontiguousarray(np.atleast_2d(pop), dtype=np.float64)
-        return _feasible_rows(pop)
+        nh = self.n_h
+        return (self.family.feasible_rows(np.ascontiguousarray(pop[:, :nh]))
+                & _tail_feasible_rows(np.ascontiguousarray(pop[:, nh:])))
 
     def cost_function(self, t_s: np.ndarray, command: np.ndarray,
                       measurement: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
@@ -298,20 +315,34 @@ class ChainSpec:
         kind = _KIND[self.channel]
         profile = self.profiled
         k, b = (1.0, 0.0) if profile else self.calibration
+        nh, family = self.n_h, self.family
+        block = max(1, _BLOCK_VALUES // max(1, v.shape[0]))
 
         def cost(pop: np.ndarray) -> np.ndarray:
             pop = np.ascontiguousarray(np.atleast_2d(pop), dtype=np.float64)
-            return population_cost(pop, kind, v, y, dt, uniform, profile, k, b)
+            costs = np.empty(pop.shape[0])
+            for a in range(0, pop.shape[0], block):
+                rows = pop[a:a + block]
+                h = np.ascontiguousarray(rows[:, :nh])
+                tail = np.ascontiguousarray(rows[:, nh:])
+                ok = family.feasible_rows(h) & _tail_feasible_rows(tail)
+                u = np.empty((rows.shape[0], v.shape[0]))
+                family.simulate_rows(h, v, ok, u)
+                _tail_costs(u, tail, ok, kind, y, dt, uniform, profile, k, b,
+                            costs[a:a + block])
+            return costs
 
         return cost
 
     def signal(self, params: np.ndarray, t_s: np.ndarray, command: np.ndarray) -> np.ndarray:
         """Pre-calibration chain output ``s`` (sensor output in H's units)."""
         p = self.check(params)
+        v = np.ascontiguousarray(command, dtype=np.float64)
         dt, uniform = _intervals(t_s)
-        out = np.empty(len(command))
-        _chain_signal(p, _KIND[self.channel], np.ascontiguousarray(command, dtype=np.float64),
-                      dt, uniform, out)
+        u = self.family.simulate(p[:self.n_h], v)
+        out = np.empty(v.shape[0])
+        _tail_signal(u, np.ascontiguousarray(p[self.n_h:]), _KIND[self.channel], dt, uniform,
+                     out)
         return out
 
     def residual(self, params: np.ndarray, t_s: np.ndarray, command: np.ndarray,
@@ -347,15 +378,16 @@ class ChainSpec:
         p = np.asarray(params, dtype=np.float64).ravel()
         if p.shape[0] != self.n_params:
             raise InvalidParametersError(
-                f'{self.channel} chain needs {self.n_params} parameters {self.names}, '
-                f'got {p.shape[0]}')
-        check_hysteresis(p[:8])
-        check_backlash(p[8:11])
+                f'{self.channel} chain ({self.family.id}) needs {self.n_params} parameters '
+                f'{self.names}, got {p.shape[0]}')
         if not np.all(np.isfinite(p)):
             raise InvalidParametersError('parameters must be finite')
-        if self.channel == 'pressure' and p[11] < 0:
+        self.family.check(p[:self.n_h])
+        check_backlash(p[self.backlash_slice])
+        sensor = p[self.sensor_slice]
+        if self.channel == 'pressure' and sensor[0] < 0:
             raise InvalidParametersError('tau_s must be >= 0')
-        if self.channel == 'flow' and (p[11] < 0 or p[12] < 0):
+        if self.channel == 'flow' and (sensor[0] < 0 or sensor[1] < 0):
             raise InvalidParametersError('zeta and omega_n must be >= 0')
         return np.ascontiguousarray(p)
 
@@ -371,11 +403,12 @@ class ChainSpec:
         return np.array([float(values[n]) for n in self.names])
 
 
-def _bounds_array(channel: str, bounds, base: np.ndarray | None) -> np.ndarray:
-    names = CHAIN_NAMES[channel]
+def _bounds_array(names: tuple[str, ...], bounds, base: np.ndarray | None,
+                  channel: str) -> np.ndarray:
     if isinstance(bounds, Mapping):
-        out = (np.array([PAPER_DOMAINS[n] for n in names], dtype=float)
-               if base is None else np.array(base, dtype=float))
+        if base is None:
+            raise ConfigError('bounds by name need a base table')
+        out = np.array(base, dtype=float)
         unknown = set(bounds) - set(names)
         if unknown:
             raise ConfigError(f'unknown parameters for the {channel} chain: {sorted(unknown)}')
@@ -393,25 +426,32 @@ def _bounds_array(channel: str, bounds, base: np.ndarray | None) -> np.ndarray:
 
 
 def chain_spec(channel: str, domains: Mapping[str, tuple[float, float]] | None = None,
-               calibration: tuple[float, float] | None = None) -> ChainSpec:
-    """Build the spec of a channel's chain with the paper's domains by default.
+               calibration: tuple[float, float] | None = None,
+               family: str | HysteresisFamily | None = None) -> ChainSpec:
+    """Build the spec of a channel's chain.
 
     Parameters
     ----------
     channel : str
         ``position``, ``pressure`` or ``flow``.
     domains : mapping, optional
-        Search domains overriding the paper's, by parameter name.
+        Search domains by parameter name. With the ``tk`` family the others
+        are the paper's; another family has no paper domains, so its H
+        domains must all be given (or derived from the data:
+        :func:`hyst_id.identification.domains.domains_from_data`).
     calibration : tuple of float, optional
         Fixed ``(k, b)``; default profiled (fitted per candidate), for the
         position channel too: H and B already carry a scale and an offset, so
         profiling adds no freedom, but it lets the search run in the
         command's scale whatever units the measurement has.
+    family : str or HysteresisFamily, optional
+        The hysteresis family (default ``tk``, the paper's).
     """
-    if channel not in CHAIN_NAMES:
-        raise ConfigError(f'unknown channel {channel!r}; expected one of {tuple(CHAIN_NAMES)}')
-    base = np.array([PAPER_DOMAINS[n] for n in CHAIN_NAMES[channel]], dtype=float)
-    spec = ChainSpec(channel=channel, bounds=base, calibration=calibration)
+    fam = get_family(family)
+    names = chain_names(channel, fam)
+    preset = {**dict(fam.paper_domains or {}), **TAIL_PAPER_DOMAINS}
+    base = np.array([preset.get(n, (-1.0, 1.0)) for n in names], dtype=float)
+    spec = ChainSpec(channel=channel, bounds=base, calibration=calibration, family=fam)
     if domains:
         spec = spec.with_bounds(domains, source='given')
     return spec

@@ -86,10 +86,17 @@ from typing import Mapping
 import numpy as np
 
 from hyst_id.errors import ConfigError
-from hyst_id.identification.chains import CHAIN_NAMES, chain_spec, ChainSpec, PAPER_DOMAINS
+from hyst_id.identification.chains import chain_spec, ChainSpec, PAPER_DOMAINS
+from hyst_id.identification.loop import (
+    loop_orientation,
+    loop_width,
+    measurement_sign,
+    steepest_slope,
+)
 from hyst_id.io.recording import Recording
-from hyst_id.signals.noise import estimate_noise_std
-from hyst_id.signals.reversals import half_period_s, reversal_indices
+from hyst_id.models.family import HysteresisFamily, LoopBox
+from hyst_id.models.registry import get_family
+from hyst_id.signals.reversals import half_period_s
 
 __all__ = [
     'AUTO',
@@ -98,11 +105,8 @@ __all__ = [
     'DomainSettings',
     'domains_from_data',
     'format_domains',
-    'loop_orientation',
-    'measurement_sign',
+    'loop_box',
     'preset_spec',
-    'reversal_response',
-    'steepest_slope',
 ]
 
 #: Name of the data-derived domains (``--domains auto``).
@@ -111,9 +115,6 @@ AUTO = 'auto'
 PAPER = 'paper'
 #: Fixed presets by name: parameter name -> (low, high).
 PRESETS: dict[str, Mapping[str, tuple[float, float]]] = {PAPER: PAPER_DOMAINS}
-
-#: Orientation index below which a loop counts as too thin to tell its direction.
-_THIN_LOOP = 0.005
 
 
 @dataclass(frozen=True)
@@ -159,177 +160,13 @@ class DomainSettings:
     zeta: tuple[float, float] = (0.0, 0.99)
 
 
-def loop_orientation(command: np.ndarray, measurement: np.ndarray) -> float:
-    """Signed area of the measured loop, normalised to [-1/2, 1/2].
+def loop_box(rec: Recording, settings: DomainSettings | None = None,
+             calibration: tuple[float, float] | None = None) -> LoopBox:
+    """Where a loop fitted to ``rec`` lives: command range, output box, slopes, width.
 
-    ``sum((y - mean y) dv) / (sum |dv| * span y)``: ``-1/2`` for a
-    rectangular counter-clockwise loop (rising on the bottom, falling on the
-    top, like the hysteresis model), ``+1/2`` for a clockwise one, near 0
-    for a line. Additive noise does not bias it.
-
-    Parameters
-    ----------
-    command, measurement : numpy.ndarray
-        The recording's command and measurement.
-
-    Returns
-    -------
-    float
-        Orientation index (negative: counter-clockwise).
-    """
-    v = np.asarray(command, dtype=np.float64)
-    y = np.asarray(measurement, dtype=np.float64)
-    dv = np.diff(v)
-    y_mid = 0.5 * (y[1:] + y[:-1])
-    travel = float(np.sum(np.abs(dv)))
-    span = float(np.ptp(y))
-    if travel <= 0.0 or span <= 0.0:
-        return 0.0
-    return float(np.sum((y_mid - y_mid.mean()) * dv) / (travel * span))
-
-
-def measurement_sign(rec: Recording) -> int:
-    """+1 if the recording's loop runs like the model's, -1 if it is mirrored.
-
-    The model's loop is counter-clockwise and rises with the command. A
-    clearly oriented loop (``|orientation| > 0.005``) decides by its
-    direction; a thin one by the sign of the command/measurement covariance.
-    A loop that runs clockwise while rising (a friction force against
-    displacement) is not representable in either sign; its direction
-    decides, because the mirrored loop is at least traversed the model's way.
-
-    Parameters
-    ----------
-    rec : Recording
-        The recording.
-
-    Returns
-    -------
-    int
-        ``+1`` or ``-1``: the ``output_sign`` an identification should find
-        (it finds it from the profiled gain; this is the data's own view).
-    """
-    orientation = loop_orientation(rec.command, rec.measurement)
-    if abs(orientation) > _THIN_LOOP:
-        return -1 if orientation > 0 else 1
-    v = np.asarray(rec.command, dtype=np.float64)
-    y = np.asarray(rec.measurement, dtype=np.float64)
-    cov = float(np.mean((v - v.mean()) * (y - y.mean())))
-    return -1 if cov < 0 else 1
-
-
-def reversal_response(command: np.ndarray, measurement: np.ndarray,
-                      travel: float = 0.05) -> float:
-    """Fraction of command reversals after which the measurement moves against the command.
-
-    After each reversal (beyond 2 % of the command span), the measurement's
-    change over the next ``travel`` command spans is compared with the new
-    command direction; it counts as *against* when it goes the other way by
-    more than 20 % of the measurement span. The model's branches are
-    monotone, so its output never does this (a slow sensor only briefly).
-
-    Returns
-    -------
-    float
-        Fraction in [0, 1] (0 when the command never reverses).
-    """
-    v = np.asarray(command, dtype=float)
-    y = np.asarray(measurement, dtype=float)
-    span_v, span_y = float(np.ptp(v)), float(np.ptp(y))
-    idx, dirs = reversal_indices(v, 0.02 * span_v)
-    revs = list(zip(idx.tolist(), dirs.tolist()))
-    against = 0
-    counted = 0
-    for j, direction in revs:
-        moved = np.flatnonzero(direction * (v[j:] - v[j]) >= travel * span_v)
-        if not moved.size:
-            continue
-        counted += 1
-        k = j + int(moved[0])
-        against += direction * (y[k] - y[j]) < -0.2 * span_y
-    return against / counted if counted else 0.0
-
-
-def steepest_slope(rec: Recording, window: float = 0.02) -> float:
-    """Steepest slope the data shows, in mean loop slopes (output span over command span).
-
-    Over every stretch in which the command travels ``window`` command spans
-    without reversing, the measurement's change, less four noise standard
-    deviations (of a difference), over the command's change; the largest.
-    A lower bound: noise cannot inflate it much, a transition sharper than
-    the window shows as the window's slope.
-
-    Parameters
-    ----------
-    rec : Recording
-        The recording.
-    window : float
-        Command travel per stretch, in command spans.
-
-    Returns
-    -------
-    float
-        Steepest slope, >= 0.
-    """
-    v = np.asarray(rec.command, dtype=np.float64)
-    y = np.asarray(rec.measurement, dtype=np.float64)
-    span_v = float(np.ptp(v))
-    y_lo, y_hi = np.percentile(y, [0.5, 99.5])
-    if not span_v > 0.0 or not y_hi > y_lo:
-        return 0.0
-    step = window * span_v
-    travel = np.concatenate([[0.0], np.cumsum(np.abs(np.diff(v)))])
-    k = np.searchsorted(travel, travel + step)
-    ok = k < v.shape[0]
-    j, k = np.flatnonzero(ok), k[ok]
-    dv = np.abs(v[k] - v[j])
-    straight = dv >= 0.9 * step                 # no reversal inside the stretch
-    if not straight.any():
-        return 0.0
-    sigma = estimate_noise_std(y)
-    dy = np.abs(y[k] - y[j])[straight] - 4.0 * np.sqrt(2.0) * sigma
-    slopes = dy / dv[straight]
-    return max(0.0, float(np.max(slopes)) / ((y_hi - y_lo) / span_v))
-
-
-def _line_crossing_range(v_lo: float, v_hi: float, u_lo: float, u_hi: float,
-                         m_lo: float, m_hi: float) -> tuple[float, float]:
-    """Range of ``c = v - u / m`` over the box and slopes ``[m_lo, m_hi]``."""
-    q = [u / m for u in (u_lo, u_hi) for m in (m_lo, m_hi)]
-    return v_lo - max(q), v_hi - min(q)
-
-
-def _line_intercept_range(v_lo: float, v_hi: float, u_lo: float, u_hi: float,
-                          m_hi: float) -> tuple[float, float]:
-    """Range of ``c = u - m v`` over the box and slopes ``[0, m_hi]``."""
-    mv = [0.0, m_hi * v_lo, m_hi * v_hi]
-    return u_lo - max(mv), u_hi - min(mv)
-
-
-def domains_from_data(rec: Recording, *, settings: DomainSettings | None = None,
-                      calibration: tuple[float, float] | None = None,
-                      overrides: Mapping[str, tuple[float, float]] | None = None
-                      ) -> ChainSpec:
-    """Chain spec for ``rec.channel`` with search domains derived from the data.
-
-    Parameters
-    ----------
-    rec : Recording
-        The recording to identify (validated or not; only its ranges,
-        timing and reversals are read).
-    settings : DomainSettings, optional
-        Widths of the domains; defaults suit any loop of the recorded span.
-    calibration : tuple of float, optional
-        Fixed ``(k, b)``; default profiled, whose virtual output scale makes
-        the domains independent of the measurement's units.
-    overrides : mapping, optional
-        Domains given by the user (params YAML or CLI); they win.
-
-    Returns
-    -------
-    ChainSpec
-        ``domain_source`` is ``'auto'`` (``'auto+given'`` with overrides);
-        ``extra`` holds the scales used and the measurement's sign.
+    With the calibration profiled (the default) the output box is the
+    virtual scale (output span = command span, centred on zero); with a
+    fixed one, the measurement mapped back through it.
 
     Raises
     ------
@@ -340,7 +177,6 @@ def domains_from_data(rec: Recording, *, settings: DomainSettings | None = None,
     s = settings or DomainSettings()
     v = np.asarray(rec.command, dtype=np.float64)
     y = np.asarray(rec.measurement, dtype=np.float64)
-    t = np.asarray(rec.t_s, dtype=np.float64)
     v_lo, v_hi = float(np.min(v)), float(np.max(v))
     span_v = v_hi - v_lo
     y_lo, y_hi = (float(q) for q in np.percentile(y, [0.5, 99.5]))
@@ -355,21 +191,59 @@ def domains_from_data(rec: Recording, *, settings: DomainSettings | None = None,
             raise ConfigError('calibration gain k must not be zero')
         s_lo, s_hi = sorted(((y_lo - b) / k, (y_hi - b) / k))
         u_mid, span_u = 0.5 * (s_lo + s_hi), s_hi - s_lo
-    slope = span_u / span_v                              # mean loop slope
-    steep_data = steepest_slope(rec)
-    steep = max(s.slope_max, s.steep_factor * steep_data)
     half_u = (0.5 + s.output_margin) * span_u
-    w_lo, w_hi = v_lo - s.command_margin * span_v, v_hi + s.command_margin * span_v
-    u_lo, u_hi = u_mid - half_u, u_mid + half_u
-    c_side = _line_crossing_range(w_lo, w_hi, u_lo, u_hi, s.slope_min * slope, steep * slope)
-    c_flat = _line_intercept_range(w_lo, w_hi, u_lo, u_hi, s.flat_slope_max * slope)
+    return LoopBox(v_lo=v_lo - s.command_margin * span_v, v_hi=v_hi + s.command_margin * span_v,
+                   v_min=v_lo, v_max=v_hi, u_lo=u_mid - half_u, u_hi=u_mid + half_u,
+                   slope=span_u / span_v,
+                   steep=max(s.slope_max, s.steep_factor * steepest_slope(rec)),
+                   slope_min=s.slope_min, flat_max=s.flat_slope_max,
+                   loop_width=loop_width(rec.t_s, v, y))
+
+
+def domains_from_data(rec: Recording, *, settings: DomainSettings | None = None,
+                      calibration: tuple[float, float] | None = None,
+                      overrides: Mapping[str, tuple[float, float]] | None = None,
+                      family: str | HysteresisFamily | None = None) -> ChainSpec:
+    """Chain spec for ``rec.channel`` with search domains derived from the data.
+
+    Parameters
+    ----------
+    rec : Recording
+        The recording to identify (validated or not; only its ranges,
+        timing and reversals are read).
+    settings : DomainSettings, optional
+        Widths of the domains; defaults suit any loop of the recorded span.
+    calibration : tuple of float, optional
+        Fixed ``(k, b)``; default profiled, whose virtual output scale makes
+        the domains independent of the measurement's units.
+    overrides : mapping, optional
+        Domains given by the user (params YAML or CLI); they win.
+    family : str or HysteresisFamily, optional
+        H's family (default ``tk``); it derives its own domains from the
+        loop box (:func:`loop_box`).
+
+    Returns
+    -------
+    ChainSpec
+        ``domain_source`` is ``'auto'`` (``'auto+given'`` with overrides);
+        ``extra`` holds the scales used, the loop box and the measurement's sign.
+
+    Raises
+    ------
+    ConfigError
+        The command or the measurement does not move, or the calibration
+        gain is zero.
+    """
+    s = settings or DomainSettings()
+    fam = get_family(family)
+    box = loop_box(rec, s, calibration)
+    t = np.asarray(rec.t_s, dtype=np.float64)
+    span_u = box.span_u / (1.0 + 2.0 * s.output_margin)
     dt_s = float(np.median(np.diff(t)))
     half_period = half_period_s(rec.t_s, rec.command)
     omega_exc = np.pi / half_period
     domains = {
-        'm_l': (0.0, steep * slope), 'm_r': (0.0, steep * slope),
-        'm_t': (0.0, s.flat_slope_max * slope), 'm_b': (0.0, s.flat_slope_max * slope),
-        'c_l': c_side, 'c_r': c_side, 'c_t': c_flat, 'c_b': c_flat,
+        **fam.domains(box),
         'm_bl': tuple(s.backlash_slope),
         'c_bl': (-0.5 * span_u, 0.5 * span_u), 'c_br': (-0.5 * span_u, 0.5 * span_u),
         'tau_s': (0.0, max(s.tau_max_half_periods * half_period, 10.0 * dt_s)),
@@ -378,24 +252,25 @@ def domains_from_data(rec: Recording, *, settings: DomainSettings | None = None,
                     max(min(s.omega_n_range_rad[1] * omega_exc, np.pi / dt_s),
                         2.0 * s.omega_n_range_rad[0] * omega_exc)),
     }
-    names = CHAIN_NAMES[rec.channel]
-    spec = chain_spec(rec.channel, calibration=calibration).with_bounds(
-        {n: domains[n] for n in names}, source=AUTO)
+    spec = chain_spec(rec.channel, calibration=calibration, family=fam)
+    spec = spec.with_bounds({n: domains[n] for n in spec.names}, source=AUTO)
     source = AUTO
     if overrides:
         spec = spec.with_bounds(overrides, source=AUTO + '+given')
         source = spec.domain_source
+    y = np.asarray(rec.measurement, dtype=np.float64)
+    y_lo, y_hi = (float(q) for q in np.percentile(y, [0.5, 99.5]))
     extra = {
-        'command_range': (v_lo, v_hi), 'measurement_range': (y_lo, y_hi),
+        'command_range': (box.v_min, box.v_max), 'measurement_range': (y_lo, y_hi),
         'virtual_output_per_measurement': span_u / (y_hi - y_lo),
-        'mean_slope': slope, 'steepest_slope': float(steep_data),
-        'output_box': (u_lo, u_hi),
+        'mean_slope': box.slope, 'steepest_slope_allowed': box.steep,
+        'output_box': (box.u_lo, box.u_hi), 'loop_box': box,
         'half_period_s': half_period, 'dt_s': dt_s,
         'measurement_sign': measurement_sign(rec),
-        'orientation': loop_orientation(v, y),
+        'orientation': loop_orientation(rec.command, y),
     }
     return ChainSpec(channel=spec.channel, bounds=spec.bounds, calibration=spec.calibration,
-                     domain_source=source, extra=extra)
+                     domain_source=source, extra=extra, family=fam)
 
 
 def preset_spec(name: str, channel: str,

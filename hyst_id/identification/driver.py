@@ -115,7 +115,7 @@ def _run_seed(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray, measurement
     if k == 0:
         raise IdentificationError('the best chain output does not vary: the measurement '
                                   'shows no response to the command')
-    x = canonical_gauge(best_x, (k, b))
+    x = canonical_gauge(best_x, (k, b), spec.family)
     return SeedRun(seed=int(seed), x_raw=best_x, x=x, sign=output_sign((k, b)),
                    fun=float(best_fun),
                    er_percent=float(er_percent(best_fun, measurement)), er_gaass_percent=er_ga,
@@ -235,7 +235,7 @@ def summarise(rec: Recording, spec: ChainSpec, settings: IdentifySettings,
               runs: list[SeedRun]) -> Identification:
     """Combine seed runs into an :class:`Identification`."""
     best = min(runs, key=lambda r: r.fun)
-    canon = chain_spec(rec.channel, calibration=(best.sign, 0.0))
+    canon = chain_spec(rec.channel, calibration=(best.sign, 0.0), family=spec.family)
     warnings = []
     same_sign = [r for r in runs if r.sign == best.sign]
     if len(same_sign) < len(runs):
@@ -254,4 +254,4 @@ def summarise(rec: Recording, spec: ChainSpec, settings: IdentifySettings,
         er_mean_params_percent=er_mean,
         noise_floor_percent=noise_floor_percent(rec.measurement),
         runs=runs, bounds=spec.bounds, domain_source=spec.domain_source,
-        settings=settings, warnings=warnings, source=rec.source)
+        settings=settings, warnings=warnings, source=rec.source, family=spec.family.id)

@@ -38,20 +38,26 @@ from __future__ import annotations
 
 import numpy as np
 
+from hyst_id.models.family import HysteresisFamily
+from hyst_id.models.registry import get_family
+
 __all__ = ['affine_map_output', 'canonical_gauge', 'output_sign']
 
 
-def affine_map_output(params: np.ndarray, alpha: float, delta: float) -> np.ndarray:
+def affine_map_output(params: np.ndarray, alpha: float, delta: float,
+                      family: str | HysteresisFamily | None = None) -> np.ndarray:
     """Re-express the chain with its H/B output replaced by ``alpha * out + delta``.
 
     Parameters
     ----------
     params : numpy.ndarray
-        Chain parameters (hysteresis 8, backlash 3, then sensor parameters).
+        Chain parameters (H's, backlash 3, then sensor parameters).
     alpha : float
         Positive scale applied after the backlash.
     delta : float
         Offset applied after the scale.
+    family : str or HysteresisFamily, optional
+        H's family (default ``tk``).
 
     Returns
     -------
@@ -60,17 +66,15 @@ def affine_map_output(params: np.ndarray, alpha: float, delta: float) -> np.ndar
     """
     if not alpha > 0:
         raise ValueError('alpha must be positive')
+    fam = get_family(family)
+    nh = fam.n_params
     p = np.array(params, dtype=np.float64)
-    m_bl = p[8]
+    m_bl = p[nh]
     # alpha*m_bl*(u - c) + delta = m_bl*(u' - c') with u' = alpha*u + delta/m_bl
-    # and c' = alpha*c: the map moves into H's lines and B's crossings.
-    p[0:4] *= alpha                      # slopes of H
-    p[4] -= delta / (m_bl * p[0])        # c_l: u' = m_l' (v - c_l'), offset delta/m_bl
-    p[5] -= delta / (m_bl * p[1])        # c_r
-    p[6] = alpha * p[6] + delta / m_bl   # c_t
-    p[7] = alpha * p[7] + delta / m_bl   # c_b
-    p[9] *= alpha                        # c_bl
-    p[10] *= alpha                       # c_br
+    # and c' = alpha*c: the map moves into H's output and B's crossings.
+    p[:nh] = fam.map_output(p[:nh], alpha, delta / m_bl)
+    p[nh + 1] *= alpha
+    p[nh + 2] *= alpha
     return p
 
 
@@ -79,8 +83,8 @@ def output_sign(calibration: tuple[float, float]) -> float:
     return -1.0 if calibration[0] < 0 else 1.0
 
 
-def canonical_gauge(params: np.ndarray, calibration: tuple[float, float] = (1.0, 0.0)
-                    ) -> np.ndarray:
+def canonical_gauge(params: np.ndarray, calibration: tuple[float, float] = (1.0, 0.0),
+                    family: str | HysteresisFamily | None = None) -> np.ndarray:
     """Return the canonical representative of a parameter vector's gauge orbit.
 
     Parameters
@@ -89,6 +93,8 @@ def canonical_gauge(params: np.ndarray, calibration: tuple[float, float] = (1.0,
         Chain parameters in search space.
     calibration : tuple of float
         ``(k, b)`` applied after the sensor; ``k`` must be non-zero.
+    family : str or HysteresisFamily, optional
+        H's family (default ``tk``).
 
     Returns
     -------
@@ -100,22 +106,19 @@ def canonical_gauge(params: np.ndarray, calibration: tuple[float, float] = (1.0,
     k, b = calibration
     if k == 0 or not np.isfinite(k):
         raise ValueError('calibration gain must be finite and non-zero')
+    fam = get_family(family)
+    nh = fam.n_params
     sign = output_sign(calibration)
     k, b = sign * k, sign * b       # y = sign * (|k| s + sign b)
     p = np.array(params, dtype=np.float64)
-    m_bl, c_bl, c_br = p[8], p[9], p[10]
+    m_bl, c_bl, c_br = p[nh], p[nh + 1], p[nh + 2]
     # B output y = m_bl (u - c); write it as y = (u' - c') with u' = m_bl u.
-    p[0:4] *= m_bl
-    p[6] *= m_bl
-    p[7] *= m_bl
-    p[8], p[9], p[10] = 1.0, m_bl * c_bl, m_bl * c_br
+    p[:nh] = fam.map_output(p[:nh], m_bl, 0.0)
+    p[nh], p[nh + 1], p[nh + 2] = 1.0, m_bl * c_bl, m_bl * c_br
     # Centre the backlash: shift u' and c' by -centre (output unchanged).
-    centre = 0.5 * (p[9] + p[10])
-    p[6] -= centre
-    p[7] -= centre
-    p[4] += centre / p[0]
-    p[5] += centre / p[1]
-    p[9] -= centre
-    p[10] -= centre
+    centre = 0.5 * (p[nh + 1] + p[nh + 2])
+    p[:nh] = fam.map_output(p[:nh], 1.0, -centre)
+    p[nh + 1] -= centre
+    p[nh + 2] -= centre
     # Calibration: y_meas = k y + b; fold into H's output (B has unit slope).
-    return affine_map_output(p, k, b)
+    return affine_map_output(p, k, b, fam)

@@ -42,10 +42,9 @@ import numpy as np
 
 from hyst_id.errors import InvalidParametersError
 from hyst_id.identification.chains import chain_spec, ChainSpec
-from hyst_id.identification.domains import loop_orientation, reversal_response
+from hyst_id.identification.loop import loop_orientation, reversal_response
 from hyst_id.identification.refine import refine
 from hyst_id.identification.result import Identification
-from hyst_id.models.tk import loop_corners, simulate_hysteresis
 from hyst_id.signals.noise import estimate_noise_std
 from hyst_id.signals.reversals import half_period_s
 from hyst_id.solvers.gaass import GaassSolver
@@ -54,7 +53,6 @@ if TYPE_CHECKING:
     from hyst_id.io.recording import Recording
 
 __all__ = [
-    'active_lines',
     'domain_edge_warnings',
     'fit_warnings',
     'identification_warnings',
@@ -70,17 +68,13 @@ FIT_FACTOR = 1.5
 CONVERGED_FACTOR = 1.1
 #: Relative spread or standard error above which a parameter is poorly determined.
 POOR_RELATIVE = 0.05
-#: A line followed over less than this fraction of the command span is barely excited.
-BARELY = 0.02
 #: Where a parameter counts as on its domain edge, in domain widths.
 EDGE_TOL = 1e-3
 #: Relative cost drop that makes a domain edge matter.
 EDGE_GAIN = 0.01
 
-#: Parameters each line of the loop determines.
-LINE_PARAMS = {'left': ('m_l', 'c_l'), 'right': ('m_r', 'c_r'), 'top': ('m_t', 'c_t'),
-               'bottom': ('m_b', 'c_b')}
-_PHYSICAL_ZERO = ('m_l', 'm_r', 'm_t', 'm_b', 'm_bl', 'tau_s', 'zeta', 'omega_n')
+#: Parameters other than H's slopes whose lower domain edge at 0 is a physical limit.
+_PHYSICAL_ZERO = ('m_bl', 'tau_s', 'zeta', 'omega_n')
 
 
 def identification_warnings(ident: Identification, rec: Recording,
@@ -103,7 +97,8 @@ def identification_warnings(ident: Identification, rec: Recording,
         Warnings, most fundamental first.
     """
     if spec is None:
-        spec = chain_spec(ident.channel).with_bounds(ident.bounds, source=ident.domain_source)
+        spec = chain_spec(ident.channel, family=ident.family).with_bounds(
+            ident.bounds, source=ident.domain_source)
     out = orientation_warnings(rec, _sign(ident))
     out += fit_warnings(ident)
     out += domain_edge_warnings(ident, rec, spec)
@@ -201,17 +196,19 @@ def domain_edge_warnings(ident: Identification, rec: Recording, spec: ChainSpec,
     best = min(ident.runs, key=lambda r: r.fun)
     best_edge = _at_edge(best.x_raw, bounds)
     out, f_same = [], None
+    units = spec.units
     for i, name in enumerate(spec.names):
         side = int(best_edge[i])
         if side == 0 or (name == 'm_bl' and spec.profiled):
             continue
-        if side < 0 and name in _PHYSICAL_ZERO and bounds[i, 0] <= 0.0:
+        zero = name in _PHYSICAL_ZERO or units[i] == 'out/cmd'
+        if side < 0 and zero and bounds[i, 0] <= 0.0:
             continue            # a physical limit, not a chosen domain
         width = bounds[i, 1] - bounds[i, 0]
         wide = bounds.copy()
         if side < 0:
             wide[i, 0] -= width
-            if name in _PHYSICAL_ZERO:
+            if zero:
                 wide[i, 0] = max(wide[i, 0], 0.0)
         else:
             wide[i, 1] += width
@@ -232,140 +229,28 @@ def domain_edge_warnings(ident: Identification, rec: Recording, spec: ChainSpec,
     return out
 
 
-def _line_terms(params: np.ndarray, command: np.ndarray
-                ) -> tuple[np.ndarray, dict[str, np.ndarray], dict[str, np.ndarray]]:
-    """H's output, and per line the samples it sets and how much it moves the output there.
-
-    The *depth* of a line at a sample is how far the output would be from
-    its value if that line were absent (the right line lifts the output off
-    the inner rising line, the top line caps it, ...).
-    """
-    p = np.asarray(params, dtype=float)[:8]
-    m_l, m_r, m_t, m_b, c_l, c_r, c_t, c_b = p
-    v = np.asarray(command, dtype=float)
-    u = simulate_hysteresis(p, v)
-    vp, up, vj, uj = v[:-1], u[:-1], v[1:], u[1:]
-    tol = 1e-9 * (1.0 + np.abs(uj))
-    rise = vj > vp
-    fall = vj < vp
-    inner_up = m_b * vj + (up - m_b * vp)
-    right = m_r * (vj - c_r)
-    top = m_t * vj + c_t
-    inner_down = m_t * vj + (up - m_t * vp)
-    left = m_l * (vj - c_l)
-    bottom = m_b * vj + c_b
-    on_top = rise & (top <= np.maximum(inner_up, right) + tol)
-    on_right = rise & ~on_top & (right >= inner_up - tol)
-    on_bottom = fall & (bottom >= np.minimum(inner_down, left) - tol)
-    on_left = fall & ~on_bottom & (left <= inner_down + tol)
-    masks = {'left': on_left, 'right': on_right, 'top': on_top, 'bottom': on_bottom,
-             'rising': rise & ~on_top & ~on_right, 'falling': fall & ~on_bottom & ~on_left}
-    depth = {'top': np.where(on_top, np.maximum(inner_up, right) - top, 0.0),
-             'right': np.where(on_right, np.minimum(right, top) - inner_up, 0.0),
-             'bottom': np.where(on_bottom, bottom - np.minimum(inner_down, left), 0.0),
-             'left': np.where(on_left, inner_down - np.maximum(left, bottom), 0.0)}
-    pad = np.zeros(1, dtype=bool)
-    return (u, {k: np.concatenate([pad, m]) for k, m in masks.items()},
-            {k: np.concatenate([[0.0], d]) for k, d in depth.items()})
-
-
-def active_lines(params: np.ndarray, command: np.ndarray) -> dict[str, np.ndarray]:
-    """Which line of the loop sets H's output at each sample.
-
-    Parameters
-    ----------
-    params : numpy.ndarray
-        Hysteresis parameters (the first 8 of a chain vector).
-    command : numpy.ndarray
-        Command per sample.
-
-    Returns
-    -------
-    dict
-        Boolean masks ``left``, ``right``, ``top``, ``bottom``, ``rising``
-        (inner lines of slope ``m_b``) and ``falling`` (slope ``m_t``); the
-        first sample and samples where the command holds belong to none.
-    """
-    return _line_terms(params, command)[1]
-
-
 def unexcited_warnings(ident: Identification, rec: Recording) -> tuple[list[str], set[str]]:
-    """Warn about lines of the identified loop that the command never drives H along.
+    """Warn about parts of the identified loop that the command never exercises.
 
-    A line that H follows over less than 2 % of the command span, and that
-    moves the output off the other lines by less than 2 % of the output span
-    (a top line touched only at its corner), leaves its parameters
-    undetermined; a left or right line that moves the output over a short
-    stretch of command is a jump whose slope is undetermined.
-
-    Returns
-    -------
-    warnings : list of str
-        One per line never (or barely) followed, or steeper than resolved.
-    names : set of str
-        Parameters left undetermined by those lines.
+    The family decides what that means (``tk``: lines of the loop never
+    followed, :func:`hyst_id.models.tk_lines.unexcited_lines`); returns the
+    warnings and the parameters they leave undetermined.
     """
-    v = np.asarray(rec.command, dtype=float)
-    span = float(np.ptp(v))
-    x = np.asarray(ident.x, dtype=float)
-    try:
-        u, masks, depth = _line_terms(x, v)
-        corners = loop_corners(x[:8])
-    except InvalidParametersError:
-        return [], set()
-    unit = f' {rec.command_unit}' if rec.command_unit else ''
-    where = {
-        'top': ('rises', 'above', corners['C'][0], 'top-right corner'),
-        'bottom': ('falls', 'below', corners['A'][0], 'bottom-left corner'),
-        'right': ('rises', 'above', corners['B'][0], 'bottom-right corner'),
-        'left': ('falls', 'below', corners['D'][0], 'top-left corner'),
-    }
-    inner = {'top': 'falling', 'bottom': 'rising'}
-    span_u = float(np.ptp(u)) or 1.0
-    out, names = [], set()
-    for line, (verb, side, v_corner, corner) in where.items():
-        mask = masks[line]
-        travel_v = float(np.ptp(v[mask])) / span if mask.sum() >= 2 else 0.0
-        travel_u = float(np.ptp(u[mask])) / span_u if mask.sum() >= 2 else 0.0
-        reach = float(np.max(depth[line])) / span_u
-        if travel_v < BARELY <= max(travel_u, reach) and line in ('left', 'right'):
-            slope = LINE_PARAMS[line][0]
-            names.add(slope)
-            out.append(f'the {line} line of the loop is steeper than the recording '
-                       f'resolves (the output crosses {100 * max(travel_u, reach):.0f} % of '
-                       f'its span within {100 * travel_v:.1f} % of the command span): {slope} '
-                       f'only says "a jump", {LINE_PARAMS[line][1]} places it')
-        if max(travel_v, travel_u, reach) >= BARELY:
-            continue
-        undetermined = list(LINE_PARAMS[line])
-        if line in inner and masks[inner[line]].sum() >= 3:
-            undetermined = undetermined[1:]      # the slope still shows on inner lines
-        names.update(undetermined)
-        extreme = float(v.max() if verb == 'rises' else v.min())
-        what = (f'{" and ".join(undetermined)} '
-                f'{"is" if len(undetermined) == 1 else "are"} not identifiable from this '
-                'recording')
-        short = (extreme < v_corner) if verb == 'rises' else (extreme > v_corner)
-        if short:
-            out.append(f'the {line} line of the loop is never reached: the command {verb} '
-                       f'to {extreme:.4g}{unit} but the {corner} of the loop is at '
-                       f'{v_corner:.4g}{unit}; {what} (drive the command {side} '
-                       f'{v_corner:.4g}{unit} to identify it)')
-        else:
-            out.append(f'the {line} line of the loop barely matters here (it sets the output '
-                       f'over less than {100 * BARELY:.0f} % of the command span and moves it '
-                       f'by less than {100 * BARELY:.0f} % of its span); {what}')
-    return out, names
+    family = ident.spec().family
+    return family.unexcited(np.asarray(ident.x, dtype=float)[:family.n_params], rec.command,
+                            rec.command_unit)
 
 
 def parameter_scales(ident: Identification, rec: Recording) -> dict[str, float]:
     """Natural scale of each canonical parameter, for relative spreads.
 
-    Slopes: the loop's mean slope (output span over command span). ``c_l``,
-    ``c_r``: the command span plus the lever of crossing at zero output far
-    from the data. ``c_t``, ``c_b``: the output span plus the lever of an
-    intercept at zero command. Backlash: the output span. ``tau_s``: the
-    excitation's half period; ``zeta``: 1; ``omega_n``: its value.
+    By unit: slopes (``out/cmd``) the loop's mean slope (output span over
+    command span); command positions (``cmd``) the command span plus the
+    lever of a crossing at zero output far from the data; output levels
+    (``out``) the output span plus the lever of an intercept at zero
+    command; ``1/out`` and ``1/out^2`` the inverse output span (squared).
+    ``tau_s``: the excitation's half period; ``zeta`` and other
+    dimensionless ones: 1; ``omega_n``: its value.
     """
     sign = _sign(ident)
     v = np.asarray(rec.command, dtype=float)
@@ -373,14 +258,17 @@ def parameter_scales(ident: Identification, rec: Recording) -> dict[str, float]:
     span_v, span_y = float(np.ptp(v)), float(np.ptp(y))
     slope = span_y / span_v
     v_mid, y_mid = 0.5 * (v.max() + v.min()), 0.5 * (y.max() + y.min())
-    scales = {'m_l': slope, 'm_r': slope, 'm_t': slope, 'm_b': slope,
-              'c_l': span_v + abs(y_mid) / slope, 'c_r': span_v + abs(y_mid) / slope,
-              'c_t': span_y + abs(v_mid) * slope, 'c_b': span_y + abs(v_mid) * slope,
-              'c_bl': span_y, 'c_br': span_y, 'tau_s': half_period_s(rec.t_s, rec.command),
-              'zeta': 1.0}
+    by_unit = {'out/cmd': slope, 'cmd': span_v + abs(y_mid) / slope,
+               'out': span_y + abs(v_mid) * slope, '1/out': 1.0 / span_y,
+               '1/out^2': 1.0 / span_y ** 2, '1': 1.0,
+               's': half_period_s(rec.t_s, rec.command)}
+    units = ident.spec().units
+    scales = {n: by_unit.get(u, 1.0) for n, u in zip(ident.names, units)}
+    scales.update({'c_bl': span_y, 'c_br': span_y})
     if 'omega_n' in ident.names:
         scales['omega_n'] = max(abs(ident.params['omega_n']), 1e-12)
-    return {n: scales[n] for n in ident.names if n in scales}
+    scales.pop('m_bl', None)
+    return scales
 
 
 def _standard_errors(ident: Identification, rec: Recording, sign: float) -> dict[str, float]:

@@ -143,6 +143,7 @@ class Identification:
     settings: IdentifySettings
     warnings: list[str] = field(default_factory=list)
     source: str = ''
+    family: str = 'tk'
 
     @property
     def x(self) -> np.ndarray:
@@ -151,8 +152,8 @@ class Identification:
 
     def spec(self) -> ChainSpec:
         """Chain spec that simulates the canonical parameters (calibration sign, 0)."""
-        return chain_spec(self.channel, calibration=(self.output_sign, 0.0)).with_bounds(
-            self.bounds, source=self.domain_source)
+        return chain_spec(self.channel, calibration=(self.output_sign, 0.0),
+                          family=self.family).with_bounds(self.bounds, source=self.domain_source)
 
     def to_dict(self) -> dict:
         """JSON-ready summary (arrays as lists)."""
@@ -162,7 +163,7 @@ class Identification:
                          'er_percent': r.er_percent, 'er_gaass_percent': r.er_gaass_percent,
                          'nfev': r.nfev, 'nit': r.nit, 'message': r.message})
         return {
-            'channel': self.channel, 'source': self.source,
+            'channel': self.channel, 'family': self.family, 'source': self.source,
             'params': self.params, 'params_mean': self.params_mean,
             'output_sign': self.output_sign,
             'calibration': {'k': self.output_sign, 'b': 0.0,

@@ -28,10 +28,10 @@ from typing import Any
 import numpy as np
 
 from hyst_id.compensation import InverseModel
+from hyst_id.compensation.params_file import COMPENSATOR_NAMES
 from hyst_id.errors import InvalidParametersError
 from hyst_id.identification import Identification
 from hyst_id.identification.chains import chain_spec
-from hyst_id.io.params_file import COMPENSATOR_NAMES
 
 __all__ = ['compensator_set', 'diagnosis_statuses', 'recovered_document', 'result_document',
            'warm_up_kernels']

@@ -12,7 +12,7 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
-"""Hysteresis H (Krasnosel'skii hysteron, Tao & Kokotovic form) and its inverse.
+"""The paper's hysteresis family ``tk``: Krasnosel'skii hysteron, Tao & Kokotovic form.
 
 Parameters are ordered ``(m_l, m_r, m_t, m_b, c_l, c_r, c_t, c_b)``: slopes
 and crossings of the left, right, top and bottom lines of the loop::
@@ -32,6 +32,10 @@ with ``c_u = u_prev - m_b v_prev`` and ``c_d = u_prev - m_t v_prev``.
 Initial state (the paper leaves it open): the output starts on the
 *rising* boundary of the major loop at ``v(0)``, as if the actuator had
 just been driven up to its starting command (:func:`initial_output`).
+
+:data:`FAMILY` is the :class:`~hyst_id.models.family.HysteresisFamily` the
+chain, the gauge, identification and the compensator use; the numba step
+rules below are its kernels.
 """
 
 from __future__ import annotations
@@ -40,9 +44,14 @@ from numba import njit
 import numpy as np
 
 from hyst_id.errors import InvalidParametersError
+from hyst_id.models.family import HysteresisFamily, HysteresisInverse, LoopBox
+from hyst_id.models.tk_lines import unexcited_lines
 
 __all__ = [
+    'FAMILY',
     'HYSTERESIS_NAMES',
+    'TaoKokotovic',
+    'TaoKokotovicInverse',
     'check_hysteresis',
     'hysteresis_feasible',
     'loop_corners',
@@ -55,6 +64,12 @@ __all__ = [
 ]
 
 HYSTERESIS_NAMES = ('m_l', 'm_r', 'm_t', 'm_b', 'c_l', 'c_r', 'c_t', 'c_b')
+#: Unit kind of each parameter.
+UNITS = {'m_l': 'out/cmd', 'm_r': 'out/cmd', 'm_t': 'out/cmd', 'm_b': 'out/cmd',
+         'c_l': 'cmd', 'c_r': 'cmd', 'c_t': 'out', 'c_b': 'out'}
+#: The paper's search domains (section 4).
+PAPER_DOMAINS = {'m_l': (0.0, 5.0), 'm_r': (0.0, 5.0), 'm_t': (0.0, 5.0), 'm_b': (0.0, 5.0),
+                 'c_l': (-5.0, 5.0), 'c_r': (-5.0, 5.0), 'c_t': (4.0, 20.0), 'c_b': (4.0, 20.0)}
 
 
 @njit(cache=True, inline='always')
@@ -254,3 +269,184 @@ def invert_hysteresis(params: np.ndarray, desired: np.ndarray, v0: float,
     if u0 is None:
         u0 = initial_output(v0, p[1], p[2], p[3], p[5], p[6], p[7])
     return _invert(p, np.ascontiguousarray(desired, dtype=np.float64), float(v0), float(u0))
+
+
+@njit(cache=True)
+def _feasible_rows(pop):
+    ok = np.empty(pop.shape[0], dtype=np.bool_)
+    for i in range(pop.shape[0]):
+        p = pop[i]
+        good = True
+        for q in range(8):
+            if not np.isfinite(p[q]):
+                good = False
+        ok[i] = good and hysteresis_feasible(p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7])
+    return ok
+
+
+@njit(cache=True)
+def _simulate_rows(pop, v, ok, out):
+    for i in range(pop.shape[0]):
+        if not ok[i]:
+            continue
+        m_l, m_r, m_t, m_b = pop[i, 0], pop[i, 1], pop[i, 2], pop[i, 3]
+        c_l, c_r, c_t, c_b = pop[i, 4], pop[i, 5], pop[i, 6], pop[i, 7]
+        u = initial_output(v[0], m_r, m_t, m_b, c_r, c_t, c_b)
+        out[i, 0] = u
+        for j in range(1, v.shape[0]):
+            u = hysteresis_step(v[j], v[j - 1], u, m_l, m_r, m_t, m_b, c_l, c_r, c_t, c_b)
+            out[i, j] = u
+
+
+def _crossing_range(v_lo: float, v_hi: float, u_lo: float, u_hi: float,
+                    m_lo: float, m_hi: float) -> tuple[float, float]:
+    """Range of ``c = v - u / m`` over the box and slopes ``[m_lo, m_hi]``."""
+    q = [u / m for u in (u_lo, u_hi) for m in (m_lo, m_hi)]
+    return v_lo - max(q), v_hi - min(q)
+
+
+def _intercept_range(v_lo: float, v_hi: float, u_lo: float, u_hi: float,
+                     m_hi: float) -> tuple[float, float]:
+    """Range of ``c = u - m v`` over the box and slopes ``[0, m_hi]``."""
+    mv = [0.0, m_hi * v_lo, m_hi * v_hi]
+    return u_lo - max(mv), u_hi - min(mv)
+
+
+class TaoKokotovicInverse(HysteresisInverse):
+    """Exact inverse of the ``tk`` loop with its own state ``(v, u)`` (model notes section 1)."""
+
+    def __init__(self, params: np.ndarray) -> None:
+        self.p = tuple(float(x) for x in check_hysteresis(params))
+        self._v = 0.0
+        self._u = 0.0
+        self.reset(0.0)
+
+    def output_range(self, v: float) -> tuple[float, float]:
+        """Lowest and highest output reachable at command ``v`` (the loop's boundaries)."""
+        m_l, m_r, m_t, m_b, c_l, c_r, c_t, c_b = self.p
+        lower = initial_output(v, m_r, m_t, m_b, c_r, c_t, c_b)
+        upper = max(min(m_t * v + c_t, m_l * (v - c_l)), m_b * v + c_b)
+        return lower, upper
+
+    def reset(self, v0: float, u0: float | None = None) -> None:
+        """State at ``v0``: on the rising boundary, or ``u0`` projected into the loop."""
+        lower, upper = self.output_range(float(v0))
+        self._v = float(v0)
+        self._u = lower if u0 is None else min(max(float(u0), lower), upper)
+
+    @property
+    def command(self) -> float:
+        """Last command."""
+        return self._v
+
+    @property
+    def output(self) -> float:
+        """Output in the state."""
+        return self._u
+
+    def command_for(self, u_d: float) -> float:
+        """Command that makes the loop output ``u_d`` next."""
+        return hysteresis_inverse_step(u_d, self._v, self._u, *self.p)
+
+    def advance(self, v: float) -> float:
+        """Move the state with command ``v``."""
+        self._u = hysteresis_step(v, self._v, self._u, *self.p)
+        self._v = float(v)
+        return self._u
+
+
+class TaoKokotovic(HysteresisFamily):
+    """The paper's 8-parameter piecewise-linear loop (family ``tk``)."""
+
+    id = 'tk'  # noqa: A003
+    title = "Krasnosel'skii / Tao-Kokotovic piecewise-linear loop (the paper's)"
+    names = HYSTERESIS_NAMES
+    units = UNITS
+    paper_domains = PAPER_DOMAINS
+
+    def check(self, params: np.ndarray) -> np.ndarray:
+        """Validate (see :func:`check_hysteresis`)."""
+        return check_hysteresis(params)
+
+    def feasible_rows(self, pop: np.ndarray) -> np.ndarray:
+        """The paper's constraints and a proper loop, per row."""
+        return _feasible_rows(np.ascontiguousarray(pop, dtype=np.float64))
+
+    def simulate_rows(self, pop: np.ndarray, v: np.ndarray, ok: np.ndarray,
+                      out: np.ndarray) -> None:
+        """H's output per feasible row, from the rising boundary at ``v[0]``."""
+        _simulate_rows(pop, v, ok, out)
+
+    def map_output(self, params: np.ndarray, alpha: float, delta: float) -> np.ndarray:
+        """Slopes times ``alpha``; output lines shifted by ``delta``, side lines moved to match."""
+        p = np.array(params, dtype=np.float64)
+        p[0:4] *= alpha
+        p[4] -= delta / p[0]
+        p[5] -= delta / p[1]
+        p[6] = alpha * p[6] + delta
+        p[7] = alpha * p[7] + delta
+        return p
+
+    def domains(self, box: LoopBox) -> dict[str, tuple[float, float]]:
+        """Domains of a loop in ``box``.
+
+        Side slopes up to ``steep``, flat ones up to ``flat_max`` mean slopes;
+        crossings of every such line through the output box at a command in
+        the widened range.
+        """
+        side = (box.slope_min * box.slope, box.steep * box.slope)
+        c_side = _crossing_range(box.v_lo, box.v_hi, box.u_lo, box.u_hi, *side)
+        c_flat = _intercept_range(box.v_lo, box.v_hi, box.u_lo, box.u_hi,
+                                  box.flat_max * box.slope)
+        return {'m_l': (0.0, box.steep * box.slope), 'm_r': (0.0, box.steep * box.slope),
+                'm_t': (0.0, box.flat_max * box.slope), 'm_b': (0.0, box.flat_max * box.slope),
+                'c_l': c_side, 'c_r': c_side, 'c_t': c_flat, 'c_b': c_flat}
+
+    def starts(self, box: LoopBox, width: float | None = None) -> list[np.ndarray]:
+        """Loops of width ``width`` (default the measured one) centred in the box.
+
+        Side slopes of one and two mean slopes, flat inner lines (a tenth of
+        the mean slope), top and bottom lines met a tenth of the span inside
+        the commanded range's ends.
+        """
+        w = box.loop_width if width is None else width
+        v_mid = 0.5 * (box.v_min + box.v_max)
+        u_mid = 0.5 * (box.u_lo + box.u_hi)
+        span = box.span_v or 1.0
+        v1, v2 = box.v_max - 0.1 * span, box.v_min + 0.1 * span
+        out = []
+        for k in (1.0, 2.0):
+            m, m_t = k * box.slope, 0.1 * box.slope
+            c_l = v_mid - 0.5 * w - u_mid / m
+            c_r = v_mid + 0.5 * w - u_mid / m
+            c_t = m * (v1 - c_r) - m_t * v1
+            c_b = m * (v2 - c_l) - m_t * v2
+            out.append(np.array([m, m, m_t, m_t, c_l, c_r, c_t, c_b]))
+        return [x for x in out if self.feasible_rows(x[None, :])[0]]
+
+    def inverse(self, params: np.ndarray) -> TaoKokotovicInverse:
+        """Exact inverse with its own state."""
+        return TaoKokotovicInverse(params)
+
+    def unexcited(self, params: np.ndarray, command: np.ndarray,
+                  command_unit: str = '') -> tuple[list[str], set[str]]:
+        """Lines of the loop the command never drives H along (see :mod:`.tk_lines`)."""
+        try:
+            p = check_hysteresis(np.asarray(params, dtype=float)[:8])
+        except InvalidParametersError:
+            return [], set()
+        return unexcited_lines(p, command, self.simulate(p, command), loop_corners(p),
+                               command_unit)
+
+    def describe(self, params: np.ndarray) -> dict[str, float]:
+        """Corner commands and outputs of the major loop, and its width at mid height."""
+        c = loop_corners(params)
+        out = {}
+        for k, (v, u) in c.items():
+            out[f'corner_{k}_cmd'] = float(v)
+            out[f'corner_{k}_out'] = float(u)
+        return out
+
+
+#: The family instance the registry holds.
+FAMILY = TaoKokotovic()

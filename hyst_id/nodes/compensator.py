@@ -50,8 +50,8 @@ from std_msgs.msg import Float64, String
 
 from hyst_id.compensation import CommandLimits, InverseModel
 from hyst_id.compensation import Compensator as CoreCompensator
+from hyst_id.compensation.params_file import COMPENSATOR_NAMES
 from hyst_id.errors import InvalidParametersError
-from hyst_id.io.params_file import COMPENSATOR_NAMES
 from hyst_id.io.recording import CHANNELS
 from hyst_id.nodes.support import (
     COMMAND_QOS,

@@ -43,14 +43,14 @@ from rclpy.parameter import Parameter
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 from std_msgs.msg import Float64, String
 
-from hyst_id.errors import ConfigError, HystIdError
-from hyst_id.identification import Identification, IdentifySettings
-from hyst_id.identification.config import make_settings, make_spec
-from hyst_id.io.params_file import (
+from hyst_id.compensation.params_file import (
     compensator_values,
     read_compensator_params,
     write_compensator_params,
 )
+from hyst_id.errors import ConfigError, HystIdError
+from hyst_id.identification import Identification, IdentifySettings
+from hyst_id.identification.config import make_settings, make_spec
 from hyst_id.io.recording import CHANNELS, Recording, validate_recording
 from hyst_id.io.topics import get_field, parse_field_path, TopicConfig
 from hyst_id.live import (

@@ -65,7 +65,7 @@ def test_swap_keeps_state_inside_the_new_loop():
     new = InverseModel.from_vector(wider)
     comp.set_model(new)
     v, u, _ = comp.state
-    lower, upper = new.output_range(v)
+    lower, upper = new.inverse().output_range(v)
     assert lower <= u <= upper
     assert np.all(np.isfinite(comp.run(DESIRED[30:])))
 

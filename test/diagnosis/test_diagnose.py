@@ -30,13 +30,13 @@ import pytest
 
 from hyst_id.cli import main
 from hyst_id.diagnosis import diagnose, DiagnoseSettings
-from hyst_id.diagnosis.baseline import loop_width
 from hyst_id.diagnosis.locate import locate, noise_std
 from hyst_id.diagnosis.mechanisms import Context, MECHANISM_IDS, MECHANISMS
 from hyst_id.diagnosis.model import ComposedModel
 from hyst_id.diagnosis.report import plot_diagnosis
 from hyst_id.errors import ConfigError, NoExcitationError, RecordingError
 from hyst_id.identification.chains import chain_spec
+from hyst_id.identification.loop import loop_width
 from hyst_id.io.recording import Recording
 from hyst_id.signals.excitation import multisine
 

@@ -31,23 +31,23 @@ import pytest
 from hyst_id.errors import ConfigError
 from hyst_id.identification import identify, IdentifySettings
 from hyst_id.identification.chains import chain_spec, PAPER_DOMAINS
-from hyst_id.identification.domains import (
-    domains_from_data,
+from hyst_id.identification.domains import domains_from_data, preset_spec
+from hyst_id.identification.gauge import affine_map_output
+from hyst_id.identification.loop import (
     loop_orientation,
     measurement_sign,
-    preset_spec,
     reversal_response,
     steepest_slope,
 )
-from hyst_id.identification.gauge import affine_map_output
 from hyst_id.identification.quality import (
-    active_lines,
     domain_edge_warnings,
     identification_warnings,
     orientation_warnings,
     poorly_determined_warnings,
 )
 from hyst_id.io.recording import Recording
+from hyst_id.models.tk import simulate_hysteresis
+from hyst_id.models.tk_lines import active_lines
 from hyst_id.signals.noise import noise_floor_percent
 
 #: (command scale a, command offset c, output span, output low) per unit system:
@@ -206,7 +206,8 @@ def test_unexcited_top_line_is_reported(identified):
 
 def test_active_lines_of_the_true_loop():
     rec = simulate_scaled('rig')
-    masks = active_lines(TRUE_PARAMS[:8], rec.command)
+    masks = active_lines(TRUE_PARAMS[:8], rec.command,
+                         simulate_hysteresis(TRUE_PARAMS[:8], rec.command))
     assert not masks['top'].any()                      # top-right corner at 15.3 mA
     for line in ('left', 'right', 'bottom', 'rising', 'falling'):
         assert masks[line].sum() > 10, line

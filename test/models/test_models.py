@@ -21,7 +21,7 @@ import pytest
 from scipy import signal
 
 from hyst_id.errors import InvalidParametersError
-from hyst_id.identification.chains import chain_spec, er_percent, population_cost
+from hyst_id.identification.chains import chain_spec, er_percent
 from hyst_id.identification.gauge import canonical_gauge
 from hyst_id.models.backlash import invert_backlash, simulate_backlash
 from hyst_id.models.sensors import simulate_first_order, simulate_second_order
@@ -174,7 +174,7 @@ def test_kernel_marks_infeasible_and_nonfinite_rows_inf():
     v = np.sin(t)
     pop = np.array([TRUE[:11], TRUE[:11]])
     pop[1, 2] = np.nan
-    costs = population_cost(pop, 0, v, v, np.full(100, 0.1), True, True, 1.0, 0.0)
+    costs = chain_spec('position').cost_function(t, v, v)(pop)
     assert np.isfinite(costs[0]) and np.isinf(costs[1])
     assert er_percent(0.0, v) == 0.0
 

@@ -38,9 +38,9 @@ from rclpy.node import Node  # noqa: E402
 from rclpy.parameter import Parameter  # noqa: E402
 from std_msgs.msg import String  # noqa: E402
 
+from hyst_id.compensation.params_file import write_compensator_params  # noqa: E402
 from hyst_id.errors import IdentificationError  # noqa: E402
 from hyst_id.identification.chains import chain_spec  # noqa: E402
-from hyst_id.io.params_file import write_compensator_params  # noqa: E402
 from hyst_id.nodes.compensator import Compensator  # noqa: E402
 from hyst_id.nodes.identifier import Identifier  # noqa: E402
 from hyst_id.nodes.support import LATCHED_QOS  # noqa: E402

@@ -32,15 +32,15 @@ from rclpy.node import Node  # noqa: E402
 from rclpy.parameter import Parameter  # noqa: E402
 from std_msgs.msg import Float64, String  # noqa: E402
 
-from hyst_id.errors import ConfigError, RecordingError  # noqa: E402
-from hyst_id.identification import identify  # noqa: E402
-from hyst_id.identification.chains import chain_spec  # noqa: E402
-from hyst_id.io.bag import iter_bag_messages, write_recording_bag  # noqa: E402
-from hyst_id.io.params_file import (  # noqa: E402
+from hyst_id.compensation.params_file import (  # noqa: E402
     COMPENSATOR_NAMES,
     read_compensator_params,
     write_compensator_params,
 )
+from hyst_id.errors import ConfigError, RecordingError  # noqa: E402
+from hyst_id.identification import identify  # noqa: E402
+from hyst_id.identification.chains import chain_spec  # noqa: E402
+from hyst_id.io.bag import iter_bag_messages, write_recording_bag  # noqa: E402
 from hyst_id.io.recording import Recording  # noqa: E402
 from hyst_id.live import pair_streams  # noqa: E402
 from hyst_id.nodes.actuator_driver import (  # noqa: E402

@@ -143,6 +143,9 @@ class Mechanism:
     smooth : bool
         Whether the cost is smooth enough in ``theta`` for least squares
         (else ``theta`` is searched on a grid / pattern search).
+    families : tuple of str or None
+        Hysteresis families the block works with (None: any); a block that
+        rewrites H itself needs the family it was written for.
     """
 
     id = ''  # noqa: A003 - the issue's word for a mechanism's name
@@ -154,6 +157,7 @@ class Mechanism:
     units: tuple[str, ...] = ()
     n_linear = 0
     smooth = True
+    families: tuple[str, ...] | None = None
 
     # -- fitting -----------------------------------------------------------
     def bounds(self, ctx: Context) -> np.ndarray:

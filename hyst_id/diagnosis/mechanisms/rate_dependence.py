@@ -68,6 +68,7 @@ class RateDependence(Mechanism):
     id = 'rate_dependence'  # noqa: A003
     title = 'hysteresis loop widening with the command rate'
     stage = 'actuator'
+    families = ('tk',)   # it rewrites the paper's loop itself
     placement = 'inside the hysteresis H (its left and right lines)'
     physics = ('rate-dependent losses in the actuator (viscous drag, eddy currents) widen '
                'the loop when the command moves fast')

@@ -75,6 +75,7 @@ class Stiction(Mechanism):
     id = 'stiction'  # noqa: A003
     title = 'stick-slip friction in the actuator'
     stage = 'position'
+    families = ('tk',)   # it rewrites the paper's loop itself
     placement = 'on the actuator position, after the backlash B, before the end stops'
     physics = ('static friction holds the actuator until the drive force exceeds it, then the '
                'actuator slips: a ramp becomes a staircase')
