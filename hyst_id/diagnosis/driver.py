@@ -59,7 +59,7 @@ from hyst_id.diagnosis.select import (
 )
 from hyst_id.errors import ConfigError, RecordingError
 from hyst_id.identification.chains import chain_spec, ChainSpec
-from hyst_id.io.recording import Recording, validate_recording
+from hyst_id.io.recording import Recording, roundoff_probe, validate_recording
 from hyst_id.signals.noise import floor_percent
 from hyst_id.signals.reversals import period_s
 from hyst_id.signals.split import split_index
@@ -158,7 +158,7 @@ def diagnose(recording: Recording, *, spec: ChainSpec | None = None,
 
 def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSettings,
               say: Callable[[str], None]) -> Diagnosis:
-    rec = validate_recording(recording)
+    rec = roundoff_probe(validate_recording(recording))
     mechs = get_mechanisms(settings.mechanisms)
     t, v_orig, y = rec.t_s, rec.command, rec.measurement
     n_train = split_index(t, settings.train_fraction)

@@ -60,7 +60,7 @@ from hyst_id.diagnosis.select import choose, compare, Comparison, Data, FitResul
 from hyst_id.diagnosis.stick_events import bands_from_demand
 from hyst_id.errors import ConfigError, HystIdError, RecordingError
 from hyst_id.identification.chains import er_percent
-from hyst_id.io.recording import Recording, validate_recording
+from hyst_id.io.recording import Recording, roundoff_probe, validate_recording
 from hyst_id.signals.noise import floor_percent
 from hyst_id.signals.reversals import reversal_times
 from hyst_id.signals.split import split_index
@@ -292,7 +292,7 @@ def diagnose_sim(recording: Recording, rig_params, *,
 
 def _diagnose_sim(recording, base, settings, say):
     from hyst_id.rig import simulate_rig
-    rec = validate_recording(recording)
+    rec = roundoff_probe(validate_recording(recording))
     t, v, y, ch = rec.t_s, rec.command, rec.measurement, rec.channel
     n_train = split_index(t, settings.train_fraction)
     if n_train < 20 or t.size - n_train < 10:

@@ -41,7 +41,7 @@ from hyst_id.identification.gauge import canonical_gauge, output_sign
 from hyst_id.identification.quality import identification_warnings
 from hyst_id.identification.refine import refine
 from hyst_id.identification.result import Identification, IdentifySettings, SeedRun
-from hyst_id.io.recording import Recording, validate_recording
+from hyst_id.io.recording import Recording, roundoff_probe, validate_recording
 from hyst_id.signals.noise import noise_floor_percent
 from hyst_id.solvers.gaass import GaassSolver
 
@@ -197,7 +197,7 @@ def identify(recording: Recording, *, spec: ChainSpec | None = None,
     -------
     Identification
     """
-    rec = validate_recording(recording)
+    rec = roundoff_probe(validate_recording(recording))
     settings = settings or IdentifySettings()
     spec = spec or domains_from_data(rec)
     if spec.channel != rec.channel:

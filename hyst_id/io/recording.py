@@ -207,14 +207,14 @@ def validate_recording(rec: Recording, *, min_samples: int = MIN_SAMPLES,
             f'{min_reversals} reversals to excite the hysteresis loop')
     if np.ptp(arrays['measurement']) <= 0.0:
         raise RecordingError('measurement is constant: the sensor shows no response')
-    return replace(rec, **roundoff_probe(arrays))
+    return replace(rec, **arrays)
 
 
 #: Environment variable of the round-off probe (``<seed>`` or ``<seed>:<relative size>``).
 ROUNDOFF_PROBE_ENV = 'HYST_ID_ROUNDOFF_PROBE'
 
 
-def roundoff_probe(arrays: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+def roundoff_probe(rec: Recording) -> Recording:
     """Perturb a validated recording at round-off level when the probe is switched on.
 
     Another CPU make sums in another order and differs in the last bits of
@@ -222,22 +222,25 @@ def roundoff_probe(arrays: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     (optionally ``<seed>:<size>``, default size ``1e-12``) every measurement
     sample is multiplied by ``1 + size * z`` (``z`` standard normal, drawn
     from ``seed``) and the whole command by one such factor (held commands
-    stay equal, their order is kept). Unset or empty: the arrays are returned
-    unchanged. ``bench/roundoff_verdicts.py`` runs the suite under it.
+    stay equal, their order is kept). Unset or empty: the recording is returned
+    unchanged. The numeric stages call it on the recordings they are given
+    (identification and diagnosis); reading and writing files do not (they
+    are exact on every CPU). ``bench/roundoff_verdicts.py`` runs the suite
+    under it.
 
     Parameters
     ----------
-    arrays : dict of numpy.ndarray
-        ``t_s``, ``command`` and ``measurement`` of a validated recording.
+    rec : Recording
+        A validated recording.
 
     Returns
     -------
-    dict of numpy.ndarray
-        The same arrays, perturbed when the probe is on.
+    Recording
+        The same recording, perturbed when the probe is on.
     """
     setting = os.environ.get(ROUNDOFF_PROBE_ENV, '').strip()
     if not setting:
-        return arrays
+        return rec
     seed, _, size = setting.partition(':')
     try:
         rng = np.random.default_rng(int(seed))
@@ -245,8 +248,6 @@ def roundoff_probe(arrays: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     except ValueError:
         raise RecordingError(f'{ROUNDOFF_PROBE_ENV}={setting!r}: expected <seed>[:<size>]') \
             from None
-    out = dict(arrays)
-    y = arrays['measurement']
-    out['measurement'] = y * (1.0 + eps * rng.standard_normal(y.shape[0]))
-    out['command'] = arrays['command'] * (1.0 + eps * float(rng.standard_normal()))
-    return out
+    y = rec.measurement
+    return replace(rec, measurement=y * (1.0 + eps * rng.standard_normal(y.shape[0])),
+                   command=rec.command * (1.0 + eps * float(rng.standard_normal())))
