@@ -192,3 +192,17 @@ def test_modules_stay_small():
     big = {m: n for m, p in MODULES.items()
            if (n := len(p.read_text(encoding='utf-8').splitlines())) > 520}
     assert not big, big
+
+
+@pytest.mark.parametrize('mod', sorted(m for m in MODULES if stage(m) != 'nodes'))
+def test_all_is_the_real_public_api(mod):
+    """``__all__`` lists names (strings) that the module defines, and it exists."""
+    import importlib
+
+    module = importlib.import_module(mod)
+    names = getattr(module, '__all__', None)
+    assert names is not None, f'{mod} has no __all__'
+    assert all(isinstance(n, str) for n in names), f'{mod}.__all__ holds non-strings'
+    missing = [n for n in names if not hasattr(module, n) and n != '__version__'
+               and not (mod == 'hyst_id' and n in module._API)]
+    assert not missing, f'{mod}.__all__ names what it lacks: {missing}'

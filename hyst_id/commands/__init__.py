@@ -12,4 +12,10 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
-"""Subcommands of the ``hyst-id`` CLI, one module each (``add_arguments``, ``run``)."""
+"""Subcommands of the ``hyst-id`` CLI, one module each (``add_arguments``, ``run``).
+
+They parse arguments and print; the work is the core's. May import every core
+stage, never :mod:`hyst_id.nodes`.
+"""
+
+__all__: list[str] = []

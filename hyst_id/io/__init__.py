@@ -12,4 +12,22 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
-"""Reading and writing recordings (CSV, rosbag2 MCAP); never imports rclpy."""
+"""Recordings in and out: the Recording value object, readers, bags, params files.
+
+========================  ===================================================
+:mod:`.recording`         :class:`Recording`, its validation, the round-off probe
+:mod:`.readers`           :func:`read_recording` (CSV or MCAP by path)
+:mod:`.csv_reader`,       the two readers; :mod:`.topics` says which topics,
+:mod:`.mcap_reader`       types and fields hold a channel
+:mod:`.streams`           two stamped streams into one recording (pairing)
+:mod:`.bag`,              rosbag2 MCAP writing (chunked, crash safe) and
+:mod:`.mcap_recover`      reading, recovery of a killed recorder's file
+:mod:`.messages`          building ROS messages for bags without rclpy
+:mod:`.params_file`       reading YAML with one-line errors
+:mod:`.jsonable`          result objects to JSON
+========================  ===================================================
+
+May import: :mod:`hyst_id.signals`, rosbags, mcap; never rclpy.
+"""
+
+__all__: list[str] = []

@@ -12,4 +12,18 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
-"""Models of the actuator chain: hysteresis H, backlash B, sensor dynamics."""
+"""Models of the actuator chain: hysteresis families, backlash B, sensor dynamics.
+
+========================  ===================================================
+:mod:`.family`            the interface every hysteresis family implements
+:mod:`.registry`          the families by id (one line per family module)
+:mod:`.tk`, :mod:`.tk_lines`  the paper's loop (family ``tk``) and its line
+                          analysis
+:mod:`.backlash`          B and its inverse
+:mod:`.sensors`           first- and second-order sensors, exact on any sampling
+========================  ===================================================
+
+May import: :mod:`hyst_id.signals`, :mod:`hyst_id.io`, numpy, numba.
+"""
+
+__all__: list[str] = []

@@ -18,6 +18,8 @@
 and returns a :class:`RigRun`; :class:`RigSimulator` runs the same physics
 one sample at a time for a real-time node. Parameters live in
 :class:`RigParams` and in ``params/pipeline.yaml`` / ``params/paper_rig.yaml``.
+
+May import: :mod:`hyst_id.models`, :mod:`hyst_id.io`, :mod:`hyst_id.signals`.
 """
 
 from __future__ import annotations

@@ -19,3 +19,5 @@ estimate and its floor, excitation profiles.
 
 May import: numpy, scipy, :mod:`hyst_id.errors`. Nothing else of the package.
 """
+
+__all__: list[str] = []

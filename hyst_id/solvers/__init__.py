@@ -20,3 +20,5 @@
 
 May import: numpy, scipy, :mod:`hyst_id.errors`.
 """
+
+__all__: list[str] = []

@@ -15,8 +15,8 @@
 """The library of physical mechanisms the diagnosis can add to the paper's chain.
 
 One module per mechanism; each exposes ``MECHANISM``, an instance of a
-:class:`~hyst_id.diagnosis.mechanisms.base.Mechanism` subclass. :data:`MECHANISMS`
-lists them by id in the issue's order.
+:class:`~hyst_id.diagnosis.mechanisms.base.Mechanism` subclass, and is listed
+once in :mod:`.registry`. :data:`MECHANISMS` holds them by id.
 
 ==========================  ==========================================  ============
 id                          placed                                      searched
