@@ -23,8 +23,8 @@ from hyst_id.identification import config, IdentifySettings
 from hyst_id.identification.chains import CHAIN_NAMES, ChainSpec
 from hyst_id.io.recording import Recording
 
-__all__ = ['add_recording_arguments', 'add_settings_arguments', 'load_recording',
-           'make_spec', 'make_settings']
+__all__ = ['add_output_arguments', 'add_recording_arguments', 'add_settings_arguments',
+           'load_recording', 'make_spec', 'make_settings']
 
 
 def add_recording_arguments(parser: argparse.ArgumentParser) -> None:
@@ -40,6 +40,12 @@ def add_recording_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--time-scale', type=float, default=None,
                         help='multiply the CSV time column by this to get seconds')
     parser.add_argument('--quiet', action='store_true', help='no progress bar')
+
+
+def add_output_arguments(parser: argparse.ArgumentParser, what: str, plot: str) -> None:
+    """``--json FILE`` (``what`` as JSON) and ``--plot`` (``plot`` says where figures go)."""
+    parser.add_argument('--json', metavar='FILE', help=f'write {what} as JSON')
+    parser.add_argument('--plot', metavar=plot.split(':')[0], help=plot.split(':', 1)[-1])
 
 
 def add_settings_arguments(parser: argparse.ArgumentParser) -> None:

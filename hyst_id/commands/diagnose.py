@@ -30,6 +30,7 @@ from pathlib import Path
 import sys
 
 from hyst_id.commands.common import (
+    add_output_arguments,
     add_recording_arguments,
     add_settings_arguments,
     load_recording,
@@ -52,8 +53,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                    help='mechanisms to test (default: all of them)')
     g.add_argument('--max-mechanisms', type=int, default=2,
                    help='most mechanisms added one after the other (default 2)')
-    g.add_argument('--json', metavar='FILE', help='write the diagnosis as JSON')
-    g.add_argument('--plot', metavar='FILE.png|DIR', help='write the figure')
+    add_output_arguments(g, 'the diagnosis', 'FILE.png|DIR:write the figure')
     g.add_argument('--sim', metavar='PARAMS.yaml',
                    help='compare the rig simulator with these parameters against the '
                    'recording (no baseline fit)')

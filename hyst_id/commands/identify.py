@@ -20,6 +20,7 @@ import argparse
 import sys
 
 from hyst_id.commands.common import (
+    add_output_arguments,
     add_recording_arguments,
     add_settings_arguments,
     load_recording,
@@ -35,9 +36,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Register the arguments of ``identify``."""
     add_recording_arguments(parser)
     add_settings_arguments(parser)
-    parser.add_argument('--json', metavar='FILE', help='write the full result as JSON')
-    parser.add_argument('--plot', metavar='DIR', help='write loop, residual and '
-                        'convergence figures (PNG) into DIR')
+    add_output_arguments(parser, 'the full result',
+                         'DIR:write loop, residual and convergence figures (PNG) into DIR')
     parser.add_argument('--params-out', metavar='FILE',
                         help='write a ROS params file for the compensator node')
 

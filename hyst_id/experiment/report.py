@@ -29,6 +29,7 @@ from hyst_id.experiment.result import CHANNELS, CLEAN_SERIES, ExperimentResult, 
 from hyst_id.experiment.run import to_backlash_gauge
 from hyst_id.identification.chains import CHAIN_NAMES, chain_spec
 from hyst_id.identification.gauge import canonical_gauge
+from hyst_id.io.jsonable import jsonable
 from hyst_id.models.tk import simulate_hysteresis
 
 __all__ = ['PAPER', 'FIGURES', 'headline', 'format_markdown', 'write_json',
@@ -269,16 +270,8 @@ def write_json(result: ExperimentResult, path: str | Path, command: str | None =
     data['paper'] = PAPER
     data['command'] = command
     data['headline'] = headline(result)
-    Path(path).write_text(json.dumps(data, indent=1, default=_jsonable) + '\n')
+    Path(path).write_text(json.dumps(jsonable(data), indent=1) + '\n')
     return Path(path)
-
-
-def _jsonable(obj):
-    if isinstance(obj, np.generic):
-        return obj.item()
-    if isinstance(obj, np.ndarray):
-        return obj.tolist()
-    raise TypeError(f'not JSON serialisable: {type(obj).__name__}')
 
 
 def _plt():

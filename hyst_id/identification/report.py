@@ -26,6 +26,7 @@ import numpy as np
 
 from hyst_id.identification import Identification
 from hyst_id.identification.chains import er_percent, PARAM_UNITS
+from hyst_id.io.jsonable import jsonable
 from hyst_id.io.recording import Recording
 
 __all__ = ['format_table', 'write_json', 'plot_identification', 'er_of']
@@ -74,15 +75,7 @@ def write_json(ident: Identification, path: str | Path, extra: dict | None = Non
     data = ident.to_dict()
     if extra:
         data.update(extra)
-    Path(path).write_text(json.dumps(data, indent=2, default=_jsonable) + '\n')
-
-
-def _jsonable(obj):
-    if isinstance(obj, np.generic):
-        return obj.item()
-    if isinstance(obj, np.ndarray):
-        return obj.tolist()
-    raise TypeError(f'not JSON serialisable: {type(obj).__name__}')
+    Path(path).write_text(json.dumps(jsonable(data), indent=2) + '\n')
 
 
 def plot_identification(ident: Identification, rec: Recording, out_dir: str | Path,

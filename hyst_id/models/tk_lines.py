@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import numpy as np
 
-
 __all__ = ['BARELY', 'LINE_PARAMS', 'active_lines', 'unexcited_lines']
 
 #: A line followed over less than this fraction of the command span is barely excited.

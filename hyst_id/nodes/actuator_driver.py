@@ -44,8 +44,8 @@ from hyst_id.models.backlash import backlash_step, check_backlash
 from hyst_id.models.tk import check_hysteresis, hysteresis_step, initial_output
 from hyst_id.nodes.support import COMMAND_QOS, HystNode, Param, SENSOR_QOS, spin_node, topic_params
 
-__all__ = ['ActuatorDriver', 'ActuatorInterface', 'PAPER_BACKLASH', 'PAPER_HYSTERESIS',
-           'PARAMS', 'SimulatedActuator', 'main']
+__all__ = ['ActuatorDriver', 'ActuatorInterface', 'actuator_problem', 'PAPER_BACKLASH',
+           'PAPER_HYSTERESIS', 'PARAMS', 'SimulatedActuator', 'main']
 
 #: The paper's induced hysteresis (section 4).
 PAPER_HYSTERESIS = {'m_l': 1.01, 'm_r': 1.05, 'm_t': 0.10, 'm_b': 0.15,
@@ -54,6 +54,16 @@ PAPER_HYSTERESIS = {'m_l': 1.01, 'm_r': 1.05, 'm_t': 0.10, 'm_b': 0.15,
 PAPER_BACKLASH = {'m_bl': 1.09, 'c_bl': 0.48, 'c_br': 1.02}
 _H_NAMES = tuple(PAPER_HYSTERESIS)
 _B_NAMES = tuple(PAPER_BACKLASH)
+
+
+def actuator_problem(values: dict[str, Any]) -> str | None:
+    """Why the simulated actuator's H and B parameters in ``values`` are invalid, or None."""
+    try:
+        check_hysteresis([values[n] for n in _H_NAMES])
+        check_backlash([values[n] for n in _B_NAMES])
+    except InvalidParametersError as exc:
+        return str(exc)
+    return None
 
 
 class ActuatorInterface(abc.ABC):
@@ -151,11 +161,7 @@ class ActuatorDriver(HystNode):
 
     def validate_params(self, values: dict[str, Any], changed: set[str]) -> str | None:
         if changed & set(_H_NAMES + _B_NAMES):
-            try:
-                check_hysteresis([values[n] for n in _H_NAMES])
-                check_backlash([values[n] for n in _B_NAMES])
-            except InvalidParametersError as exc:
-                return str(exc)
+            return actuator_problem(values)
         return None
 
     def apply_params(self, values: dict[str, Any], changed: set[str]) -> None:

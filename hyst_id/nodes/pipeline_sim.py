@@ -50,11 +50,10 @@ import numpy as np
 from sensor_msgs.msg import FluidPressure, JointState
 from std_msgs.msg import Float64
 
-from hyst_id.errors import ConfigError, InvalidParametersError
-from hyst_id.models.backlash import check_backlash
+from hyst_id.errors import ConfigError
 from hyst_id.models.sensors import first_order_coefficient, second_order_coefficients
-from hyst_id.models.tk import check_hysteresis
-from hyst_id.nodes.actuator_driver import PAPER_BACKLASH, PAPER_HYSTERESIS, SimulatedActuator
+from hyst_id.nodes.actuator_driver import (actuator_problem, PAPER_BACKLASH, PAPER_HYSTERESIS,
+                                           SimulatedActuator)
 from hyst_id.nodes.support import COMMAND_QOS, HystNode, Param, SENSOR_QOS, spin_node, topic_params
 
 __all__ = ['PARAMS', 'PipelineSim', 'PlantModel', 'PlantReading', 'RigPlant', 'SimplePlant',
@@ -239,12 +238,7 @@ class PipelineSim(HystNode):
                                f' -> {", ".join(outs)}')
 
     def validate_params(self, values: dict[str, Any], changed: set[str]) -> str | None:
-        try:
-            check_hysteresis([values[n] for n in _H_NAMES])
-            check_backlash([values[n] for n in _B_NAMES])
-        except InvalidParametersError as exc:
-            return str(exc)
-        return None
+        return actuator_problem(values)
 
     def _on_command(self, msg: Float64, info: dict) -> None:
         command = float(msg.data)

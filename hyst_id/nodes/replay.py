@@ -30,13 +30,17 @@ import threading
 import time
 from typing import Any
 
-import rclpy
-from rclpy.executors import ExternalShutdownException
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
 from hyst_id.errors import ConfigError, HystIdError, RecordingError
 from hyst_id.io.bag import default_typestore, iter_bag_messages, open_bag
-from hyst_id.nodes.support import HystNode, IDENTIFIED_PARAMS_TOPIC, init_ros, message_class, Param
+from hyst_id.nodes.support import (
+    HystNode,
+    IDENTIFIED_PARAMS_TOPIC,
+    message_class,
+    Param,
+    spin_node,
+)
 
 __all__ = ['PARAMS', 'Replay', 'main']
 
@@ -164,24 +168,7 @@ class Replay(HystNode):
 
 def main(args: list[str] | None = None) -> int:
     """Play the bag; exit 0 when done, 2 on an unreadable bag."""
-    if not init_ros(args, 'replay'):
-        return 2
-    node = None
-    code = 0
-    try:
-        node = Replay()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    except HystIdError as exc:
-        rclpy.logging.get_logger('replay').error(str(exc))
-        code = 2
-    finally:
-        if node is not None:
-            code = code or node.exit_code
-            node.destroy_node()
-        rclpy.try_shutdown()
-    return code
+    return spin_node(Replay, 'replay', args)
 
 
 if __name__ == '__main__':

@@ -90,11 +90,13 @@ def spin_node(node_class: type, name: str, args: list[str] | None = None) -> int
     The demo_nodes_py pattern: Ctrl-C and an external shutdown (SIGTERM) end
     the spin quietly; a :class:`~hyst_id.errors.HystIdError` raised while the
     node is built (a bad params file) is logged in one line with exit code 2;
-    the node is always destroyed and the context shut down.
+    the node is always destroyed and the context shut down. A node may set
+    ``exit_code`` (e.g. the replay when its bag is unreadable); it is returned.
     """
     if not init_ros(args, name):
         return 2
     node = None
+    code = 0
     try:
         node = node_class()
         rclpy.spin(node)
@@ -102,12 +104,13 @@ def spin_node(node_class: type, name: str, args: list[str] | None = None) -> int
         pass
     except HystIdError as exc:
         rclpy.logging.get_logger(name).error(str(exc))
-        return 2
+        code = 2
     finally:
         if node is not None:
+            code = code or int(getattr(node, 'exit_code', 0) or 0)
             node.destroy_node()
         rclpy.try_shutdown()
-    return 0
+    return code
 
 
 def stamp_ns(stamp: Any) -> int:
