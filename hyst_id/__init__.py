@@ -33,6 +33,12 @@ so ``import hyst_id`` stays light (a node does not pay for the optimisers).
 """
 
 from hyst_id import _deprecated
+from hyst_id.pins import pin_numerics
+
+# Same numerics for every entry point (hyst-id, the nodes, scripts) when hyst_id comes
+# before NumPy: pins OpenBLAS, NumPy dispatch and the numba target where that is
+# possible (docs/reproducibility.md). A program that imported NumPy first keeps its own.
+pin_numerics()
 
 __version__ = '0.2.0'
 

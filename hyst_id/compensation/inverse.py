@@ -47,7 +47,7 @@ from hyst_id.models.backlash import (
 from hyst_id.models.family import HysteresisFamily, HysteresisInverse
 from hyst_id.models.registry import DEFAULT_FAMILY, get_family
 
-__all__ = ['InverseModel', 'CommandLimits', 'Compensator']
+__all__ = ['InverseModel', 'CommandLimits', 'Compensator', 'warm_up']
 
 
 @dataclass(frozen=True)
@@ -254,3 +254,15 @@ class Compensator:
         for j, d in enumerate(desired):
             out[j] = self.step(float(d), None if t_s is None else float(t_s[j]))
         return out
+
+
+def warm_up(model: InverseModel, n_samples: int = 16) -> None:
+    """Run a throwaway compensator over a short sweep so that its kernels are compiled.
+
+    The first call of a numba kernel compiles it (or loads it from the
+    cache), which can take seconds; a node calls this before it applies a
+    new parameter set so that the first real sample is not late.
+    """
+    comp = Compensator(model, v0=0.0)
+    for desired in np.linspace(-1.0, 1.0, n_samples):
+        comp.step(float(desired), None)

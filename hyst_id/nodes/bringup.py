@@ -32,6 +32,13 @@ sensor calibration into command-equivalent units, with the desired Eq. 25
 value it answers. Every node reads its parameters from the same params file
 (sections by node name); ``time_scale`` in the ``bringup`` section runs the
 whole experiment faster than real time.
+
+The run is the same on any machine and under any load: each excitation
+waits until the measurement answering its previous sample has arrived
+(lockstep, :class:`Lockstep`), the pipeline simulator advances by the
+run's sample period per command rather than by wall-clock stamps
+(``step_s``), and the compensator compiles its inverse before it takes
+the first sample. A slow machine only takes longer.
 """
 
 from __future__ import annotations
@@ -70,7 +77,7 @@ from hyst_id.nodes.support import (
     stamp_ns,
 )
 
-__all__ = ['Bringup', 'PARAMS', 'control_error_percent', 'main']
+__all__ = ['Bringup', 'Lockstep', 'PARAMS', 'control_error_percent', 'main']
 
 PARAMS = [
     Param('channel', 'position', 'channel identified and compensated', choices=CHANNELS,
@@ -91,7 +98,46 @@ PARAMS = [
           read_only=True),
     Param('timeout_s', 600.0, 'give up (exit 1) after this long', low=1.0, high=86400.0,
           unit='s', read_only=True),
+    Param('lockstep_timeout_s', 2.0, 'wall-clock wait for the answer to a sample before '
+          'counting it lost and going on', low=0.01, high=600.0, unit='s', read_only=True),
 ]
+
+
+class Lockstep:
+    """Hold an excitation's sample ``k`` until ``k`` measurements of its run arrived.
+
+    ``answered()`` is called for every measurement; ``ready(k)`` is the
+    excitation's gate. A measurement that never comes (best-effort sensor
+    data) holds the run for ``timeout_s`` of wall clock, then counts as
+    lost: :attr:`lost` says how many.
+    """
+
+    def __init__(self, timeout_s: float) -> None:
+        self.timeout_s = float(timeout_s)
+        self.lost = 0
+        self._count = 0
+        self._base = 0
+        self._since = time.monotonic()
+
+    def answered(self) -> None:
+        """One measurement arrived."""
+        self._count += 1
+
+    def ready(self, k: int) -> bool:
+        """Whether sample ``k`` of the current run may go out."""
+        now = time.monotonic()
+        if k == 0:
+            self._base = self._count
+        missing = k - (self._count - self._base)
+        if missing <= 0:
+            self._since = now
+            return True
+        if now - self._since < self.timeout_s:
+            return False
+        self.lost += missing
+        self._base -= missing
+        self._since = now
+        return True
 
 
 def control_error_percent(output: np.ndarray, desired: np.ndarray) -> float:
@@ -138,6 +184,12 @@ class Bringup(HystNode):
                       self.compensator, self.excite_identify, self.excite_plain,
                       self.excite_comp]
         self._k, self._b = k, b
+        self.lockstep = Lockstep(v['lockstep_timeout_s'])
+        for exc in (self.excite_identify, self.excite_plain, self.excite_comp):
+            exc.ready = self.lockstep.ready
+        self._periods = {'identify': v['identify_sample_period_s'],
+                         'compensate': v['compensate_sample_period_s']}
+        self.pipeline.set_parameters([Parameter('step_s', value=self._periods['identify'])])
         cfg = TopicConfig.for_channel(ch)
         self._field = parse_field_path(self.identifier.p(f'topics.{ch}_field'))
         self._buffers = {'uncompensated': SampleBuffer(), 'compensated': SampleBuffer()}
@@ -171,6 +223,7 @@ class Bringup(HystNode):
 
     # -------------------------------------------------------------- samples
     def _on_measurement(self, msg: Any, info: dict) -> None:
+        self.lockstep.answered()
         buf = self._buffers.get(self._phase)
         if buf is None:
             return
@@ -216,6 +269,8 @@ class Bringup(HystNode):
                 self.done.set_result(False)
             elif self._identified and self.compensator.model is not None:
                 self.identifier.set_parameters([Parameter('collect', value=False)])
+                self.pipeline.set_parameters(
+                    [Parameter('step_s', value=self._periods['compensate'])])
                 self._goto('uncompensated')
                 self.excite_plain.request_start()
             elif self._identified and (
@@ -268,6 +323,8 @@ class Bringup(HystNode):
             f'    uncompensated  {self.results.get("uncompensated", math.nan):8.3f} %',
             f'    compensated    {self.results.get("compensated", math.nan):8.3f} %',
             f'  bag: {self.recorder.path}',
+            *([f'  WARNING: {self.lockstep.lost} measurement(s) never arrived (lockstep '
+               'went on without them)'] if self.lockstep.lost else []),
             f'  compensator params: {self.identifier.params_out}',
         ]
         print('\n'.join(lines), flush=True)

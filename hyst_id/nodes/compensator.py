@@ -50,6 +50,7 @@ from std_msgs.msg import Float64, String
 
 from hyst_id.compensation import CommandLimits, InverseModel
 from hyst_id.compensation import Compensator as CoreCompensator
+from hyst_id.compensation.inverse import warm_up
 from hyst_id.compensation.params_file import COMPENSATOR_NAMES
 from hyst_id.errors import InvalidParametersError
 from hyst_id.io.recording import CHANNELS
@@ -134,6 +135,8 @@ class Compensator(HystNode):
         super().__init__('compensator', PARAMS, **kwargs)
         values = self.param_values()
         kind, model, unset = _model_state(values)
+        if model is not None:
+            warm_up(model)
         self._comp = CoreCompensator(model, _limits(values), v0=values['initial_command'])
         self._source = 'params' if model is not None else ''
         self._n = 0
@@ -200,6 +203,8 @@ class Compensator(HystNode):
         if changed & _MODEL_KEYS:
             kind, model, unset = _model_state(values)
             if model is None or model != self._comp.model:
+                if model is not None:
+                    warm_up(model)   # compile before the first real sample, not on it
                 self._comp.set_model(model)
                 if model is not None:
                     self._source = source

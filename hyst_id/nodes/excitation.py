@@ -21,6 +21,10 @@ Sample ``k`` carries the profile's value at profile time ``t = k *
 sample_period_s`` (so values never depend on timer jitter) and is published
 ``sample_period_s / time_scale`` wall-clock seconds after sample ``k - 1``;
 ``time_scale`` > 1 runs the paper's experiment faster than real time.
+A program that embeds the node can hold the run in lockstep with its
+consumers through :attr:`Excitation.ready` (``ready(k)`` False keeps
+sample ``k`` for a later tick): the bringup waits until sample ``k - 1``
+was answered, so a slow or busy machine only takes longer.
 The run starts when ``wait_for_subscribers`` subscribers are matched (then
 ``start_delay_s`` later) and ends after ``duration_s`` of profile time; with
 ``shutdown_when_done`` the process then exits 0.
@@ -135,6 +139,8 @@ class Excitation(HystNode):
         self._wait_since: float | None = None
         self._start_requested = bool(self.p('autostart'))
         self.on_finished: Callable[[], None] | None = None
+        #: ``ready(k)`` -> bool, asked before sample ``k`` goes out; False holds it.
+        self.ready: Callable[[int], bool] | None = None
         self.create_timer(1.0, self._status)
         self.create_timer(0.02, self._wait_and_start)
 
@@ -220,6 +226,8 @@ class Excitation(HystNode):
         if self._k >= self._n_samples:
             self._timer.cancel()
             self._finish()
+            return
+        if self.ready is not None and not self.ready(self._k):
             return
         t_s = self._k * self.p('sample_period_s')
         if not try_publish(self._pub, Float64(data=self._profile(t_s))):

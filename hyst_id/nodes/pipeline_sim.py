@@ -28,7 +28,11 @@ the whole plant (run it without an actuator_driver).
 
 Samples are stamped with the time the command reached the node (the
 middleware's receive timestamp), like the actuator driver's, and sensor
-dynamics advance by the time between those stamps (times ``time_scale``).
+dynamics advance by the time between those stamps (times ``time_scale``),
+or by a fixed ``step_s`` of simulated time per command when it is set:
+then the simulated run does not depend on when messages arrive, and is
+the same on a slow or busy machine (the bringup sets it to each run's
+sample period).
 The flow message (``std_msgs/Float64``) has no header: its time is when it
 was published, so keep the sample period above the node's processing delay.
 
@@ -208,6 +212,8 @@ PARAMS = [
     Param('publish_position', False, 'also publish the position (off when an actuator_driver '
           'publishes it)', read_only=True),
     Param('time_scale', 1.0, 'simulated seconds per wall-clock second', low=1e-3, high=1e4),
+    Param('step_s', 0.0, 'simulated time per command (0 = the time between command stamps '
+          'x time_scale)', low=0.0, high=1e4, unit='s'),
     Param('joint_name', 'valve', 'JointState name of the actuator joint', read_only=True),
     *topic_params(),
 ]
@@ -248,7 +254,8 @@ class PipelineSim(HystNode):
         ns = int(info.get('received_timestamp') or 0) or self.get_clock().now().nanoseconds
         dt_s = 0.0 if self._last_ns is None else (ns - self._last_ns) * 1e-9
         self._last_ns = ns
-        reading = self.plant.step(command, dt_s * self.p('time_scale'))
+        step_s = self.p('step_s')
+        reading = self.plant.step(command, step_s if step_s > 0 else dt_s * self.p('time_scale'))
         stamp = Time()
         stamp.sec, stamp.nanosec = divmod(ns, 1_000_000_000)
         if self._pos_pub is not None:
