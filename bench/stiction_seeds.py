@@ -16,8 +16,8 @@
 
 The synthetic stiction record of ``test/diagnosis/test_diagnose.py`` (the paper's chain,
 slip band 4 % of the travel, 0.005 noise) with seeds 5-16, diagnosed with the
-test's settings. The figures in docs/diagnosis.md ("9 of 12 noise seeds end
-at the noise floor on held-out data") come from this script.
+test's settings, one seed at a time. The spread over seeds and round-off
+that the tests' thresholds come from is ``bench/claim_spreads.py``.
 
 Usage (from the repository root)::
 

@@ -30,8 +30,9 @@ variable                       effect
 
 They only apply on x86-64 CPUs with AVX2 and FMA (every x86 server since
 2013), only before NumPy is imported, and never override a value the user
-set. ``./run`` sets them for the tests and the demo; ``hyst-id`` sets them
-at start-up (:func:`pin_numerics`). A library user who imports NumPy first
+set. ``./run`` sets them for the tests and the demo; ``hyst-id`` and
+``import hyst_id`` set them (:func:`pin_numerics`), so the nodes and the
+CLI compute with the same kernels. A library user who imports NumPy first
 keeps the unpinned kernels, and the answers are still expected to hold
 (that is what ``bench/roundoff_verdicts.py`` measures).
 """
