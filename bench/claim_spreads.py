@@ -46,6 +46,10 @@ from hyst_id.diagnosis import diagnose  # noqa: E402
 from hyst_id.io.readers import read_recording  # noqa: E402
 
 
+#: Print every run, not only the summary (``--verbose``).
+VERBOSE = False
+
+
 def _probe(seed: int | None) -> None:
     if seed is None:
         os.environ.pop('HYST_ID_ROUNDOFF_PROBE', None)
@@ -76,6 +80,9 @@ def synthetic_spreads(mechs: list[str], seeds: list[int], probes: list[int | Non
                 b, f = d.baseline.er_holdout_percent, d.final.er_holdout_percent
                 gains.append(1.0 - f / b)
                 ratios.append(f / d.noise_floor_percent)
+                if VERBOSE:
+                    print(f'  {mech} seed {seed} probe {probe}: {d.verdict}, held-out '
+                          f'{b:.4g} -> {f:.4g}, floor {d.noise_floor_percent:.4g}', flush=True)
         print(_row(mech, verdicts, gains, ratios), flush=True)
     _probe(None)
 
@@ -94,6 +101,9 @@ def bag_spreads(probes: list[int | None], names: list[str]) -> None:
             b, f = d.baseline.er_holdout_percent, d.final.er_holdout_percent
             gains.append(1.0 - f / b)
             ratios.append(f / d.noise_floor_percent)
+            if VERBOSE:
+                print(f'  {name} probe {probe}: {d.verdict}, held-out {b:.4g} -> {f:.4g}, '
+                      f'floor {d.noise_floor_percent:.4g}', flush=True)
         print(_row(f'{name} ({expected})', verdicts, gains, ratios), flush=True)
     _probe(None)
 
@@ -106,7 +116,10 @@ def main() -> int:
     ap.add_argument('--probes', type=int, default=2, help='round-off probe seeds (plus none)')
     ap.add_argument('--only', default='', help='comma-separated mechanisms, or "bags"')
     ap.add_argument('--bags', default='', help='comma-separated bag names (default: all)')
+    ap.add_argument('--verbose', action='store_true', help='print every run')
     args = ap.parse_args()
+    global VERBOSE
+    VERBOSE = args.verbose
     probes = [None] + list(range(1, args.probes + 1))
     only = [m for m in args.only.split(',') if m]
     mechs = [m for m in MECHANISM_IDS if not only or m in only]

@@ -42,9 +42,10 @@ import numpy as np
 from scipy import signal as sps
 from scipy import stats
 
+from hyst_id.signals.noise import quantum
 from hyst_id.signals.reversals import reversal_times
 
-__all__ = ['Localization', 'locate', 'newey_west_t', 'noise_std', 'quantum']
+__all__ = ['Localization', 'locate', 'newey_west_t', 'noise_std']
 
 Z99 = 2.5758   # two-sided 99 % normal quantile
 Z_FAMILY = 3.29  # two-sided 99.9 %: bound for the largest of many correlation lags
@@ -151,19 +152,6 @@ class Localization:
             'spectrum': clean(self.spectrum), 'features': self.features,
             'regions_s': [[float(a), float(b)] for a, b, _ in self.regions],
         }
-
-
-def quantum(measurement: np.ndarray) -> float:
-    """A/D step of a quantised measurement (0 when the values are not on a grid)."""
-    y = np.asarray(measurement, dtype=np.float64)
-    d = np.abs(np.diff(y))
-    d = d[d > 0]
-    if d.size < 10:
-        return 0.0
-    q = float(np.min(d))
-    k = (y - y[0]) / q
-    on_grid = np.mean(np.abs(k - np.round(k)) < 0.02) > 0.99
-    return q if on_grid and np.mean(np.diff(y) == 0) > 0.02 else 0.0
 
 
 def noise_std(measurement: np.ndarray) -> float:

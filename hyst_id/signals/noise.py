@@ -36,7 +36,12 @@ from math import comb
 
 import numpy as np
 
-__all__ = ['estimate_noise_std', 'floor_percent', 'noise_floor_percent']
+__all__ = ['estimate_noise_std', 'floor_percent', 'held_share', 'noise_floor_percent',
+           'quantum', 'REPEAT_TOLERANCE']
+
+#: Steps below this share of the signal's magnitude count as repeats: a value written
+#: through a unit conversion, or perturbed at round-off level, is still the same A/D count.
+REPEAT_TOLERANCE = 1e-9
 
 #: Share of the differences kept by the trimmed RMS.
 _KEEP = 0.95
@@ -65,15 +70,50 @@ def estimate_noise_std(measurement: np.ndarray) -> float:
         if d.size < 8:
             continue
         dev = np.abs(d - np.median(d))
-        kept = dev[dev <= np.quantile(dev, _KEEP)]
+        cut = float(np.quantile(dev, _KEEP))
+        # ties (quantised data) stay together when the last bits move
+        kept = dev[dev <= cut * (1.0 + 1e-6) + _repeat_tolerance(y)]
         rms = np.sqrt(np.mean(kept ** 2) / _TRIM_FACTOR)
         estimates.append(rms / np.sqrt(comb(2 * order, order)))
     sigma = min(estimates) if estimates else 0.0
     steps = np.abs(np.diff(y))
-    steps = steps[steps > 0]
-    if steps.size and np.mean(np.diff(y) == 0) > 0.2:
+    tol = _repeat_tolerance(y)
+    steps = steps[steps > tol]
+    if steps.size and held_share(y) > 0.2:
         sigma = max(sigma, float(np.min(steps)) / np.sqrt(12.0))
     return float(sigma)
+
+
+def _repeat_tolerance(y: np.ndarray) -> float:
+    return REPEAT_TOLERANCE * float(np.max(np.abs(y))) if y.size else 0.0
+
+
+def held_share(measurement: np.ndarray) -> float:
+    """Share of consecutive samples that repeat the previous value (to round-off)."""
+    y = np.asarray(measurement, dtype=np.float64)
+    if y.size < 2:
+        return 0.0
+    return float(np.mean(np.abs(np.diff(y)) <= _repeat_tolerance(y)))
+
+
+def quantum(measurement: np.ndarray) -> float:
+    """A/D step of a quantised measurement (0 when the values are not on a grid).
+
+    The smallest step between consecutive samples, when (nearly) every value
+    lies on a grid of that step and at least 2 % of the samples repeat the
+    previous one. Repeats and grid are judged to round-off
+    (:data:`REPEAT_TOLERANCE`), so the answer does not change with the last
+    bits of the values.
+    """
+    y = np.asarray(measurement, dtype=np.float64)
+    d = np.abs(np.diff(y))
+    d = d[d > _repeat_tolerance(y)]
+    if d.size < 10:
+        return 0.0
+    q = float(np.min(d))
+    k = (y - y[0]) / q
+    on_grid = np.mean(np.abs(k - np.round(k)) < 0.02) > 0.99
+    return q if on_grid and held_share(y) > 0.02 else 0.0
 
 
 def noise_floor_percent(measurement: np.ndarray, noise_std: float | None = None) -> float:

@@ -57,3 +57,25 @@ def test_rig_channels_match_their_known_noise():
 def test_floor_from_known_noise():
     y = np.full(400, 10.0)
     assert noise_floor_percent(y, noise_std=0.1) == pytest.approx(1.0)
+
+
+@pytest.mark.parametrize('probe_seed', [1, 2, 3])
+def test_quantised_data_read_the_same_after_round_off(probe_seed):
+    """Last-bit changes to A/D data keep its grid and its noise estimate (issue 11).
+
+    Exact repeats used to decide whether data are quantised; a relative
+    change of 1e-12 per sample (another CPU make's arithmetic, or a unit
+    conversion) removed them and the diagnosis read the noise 30 % low.
+    """
+    from hyst_id.diagnosis.locate import noise_std
+    from hyst_id.signals.noise import quantum
+    t = np.arange(0, 100, 0.05)
+    q = 16.0 / 1024                      # 10 bits over 16 mA: steps longer than the noise
+    clean = 9 + 2 * np.sin(2 * np.pi * t / 10)
+    y = np.round((clean + np.random.default_rng(1).normal(0, 0.005, t.size)) / q) * q
+    z = np.random.default_rng(probe_seed).standard_normal(t.size)
+    y_probed = y * (1.0 + 1e-12 * z)
+    assert quantum(y) == pytest.approx(q, rel=1e-9)
+    assert quantum(y_probed) == pytest.approx(q, rel=1e-6)
+    assert noise_std(y_probed) == pytest.approx(noise_std(y), rel=1e-6)
+    assert estimate_noise_std(y_probed) == pytest.approx(estimate_noise_std(y), rel=1e-6)
