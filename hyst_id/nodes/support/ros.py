@@ -27,7 +27,7 @@ from typing import Any, Mapping
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 import rclpy
-from rclpy.executors import ExternalShutdownException
+from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.node import Node
 
@@ -88,8 +88,10 @@ def spin_node(node_class: type, name: str, args: list[str] | None = None) -> int
     """Init, spin and shut down one node: the body of every node's ``main()``.
 
     The demo_nodes_py pattern: Ctrl-C and an external shutdown (SIGTERM) end
-    the spin quietly; a :class:`~hyst_id.errors.HystIdError` raised while the
-    node is built (a bad params file) is logged in one line with exit code 2;
+    the spin quietly, also when they land while rclpy builds its executor or
+    wait set (an ``RCLError`` on a context already shut down); a
+    :class:`~hyst_id.errors.HystIdError` raised while the node is built (a bad
+    params file) is logged in one line with exit code 2;
     the node is always destroyed and the context shut down. A node may set
     ``exit_code`` (e.g. the replay when its bag is unreadable); it is returned.
     """
@@ -98,13 +100,23 @@ def spin_node(node_class: type, name: str, args: list[str] | None = None) -> int
     node = None
     code = 0
     try:
+        # made before the node (the slow part), so a signal during construction cannot
+        # leave a half-built executor behind
+        executor = SingleThreadedExecutor()
         node = node_class()
-        rclpy.spin(node)
+        executor.add_node(node)
+        executor.spin()
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     except HystIdError as exc:
         rclpy.logging.get_logger(name).error(str(exc))
         code = 2
+    except _RCLError as exc:
+        # A SIGINT/SIGTERM that shuts the context down while the executor is being made
+        # or builds its wait set surfaces as RCLError, not as an external shutdown.
+        if rclpy.ok():
+            print(f'{name}: error: {first_line(exc)}', file=sys.stderr)
+            code = 1
     finally:
         if node is not None:
             code = code or int(getattr(node, 'exit_code', 0) or 0)
