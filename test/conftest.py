@@ -33,7 +33,7 @@ TRUE_PARAMS = np.array([1.01, 1.05, 0.10, 0.15, -0.25, 0.50, 14.0, 7.0,
 #: Affine sensor calibration per channel (output units per position unit, offset).
 CALIBRATION = {'position': (1.0, 0.0), 'pressure': (50.0, 1000.0), 'flow': (4.0, 2.0)}
 
-_domain_ids = itertools.count(60)
+_domain_ids = itertools.count(0)
 
 
 def simulate_channel(channel: str, *, noise_percent: float = 0.5, seed: int = 1,
@@ -64,8 +64,15 @@ def simulated():
 
 @pytest.fixture
 def ros_domain(monkeypatch):
-    """A ROS domain id of its own for this test, localhost discovery only."""
-    domain = str(next(_domain_ids) + (os.getpid() % 40))
+    """A ROS domain id of its own for this test, localhost discovery only.
+
+    Distinct per test and per pytest-xdist worker (workers of one run share
+    their parent's pid, so runs started side by side also differ).
+    """
+    worker = int(os.environ.get('PYTEST_XDIST_WORKER', 'gw0')[2:] or 0)
+    workers = int(os.environ.get('PYTEST_XDIST_WORKER_COUNT', '1'))
+    base = (os.getppid() if workers > 1 else os.getpid()) % 20
+    domain = str(1 + ((base + next(_domain_ids)) * workers + worker) % 230)
     monkeypatch.setenv('ROS_DOMAIN_ID', domain)
     monkeypatch.setenv('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
     return int(domain)
