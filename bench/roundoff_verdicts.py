@@ -48,11 +48,12 @@ import xml.etree.ElementTree as ET
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def run_suite(probe: str, xml_path: Path, marker: str, keyword: str | None) -> int:
+def run_suite(probe: str, xml_path: Path, marker: str, keyword: str | None,
+              workers: int = 2) -> int:
     """Run pytest with the probe setting; return its exit code."""
     env = dict(os.environ, HYST_ID_ROUNDOFF_PROBE=probe, ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
     cmd = [sys.executable, '-m', 'pytest', '-q', '-p', 'no:cacheprovider', '-m', marker,
-           f'--junitxml={xml_path}']
+           f'--junitxml={xml_path}', '-n', str(workers)]
     if keyword:
         cmd += ['-k', keyword]
     print(f'[roundoff] probe {probe or "off"}: {" ".join(cmd[3:])}', flush=True)
@@ -100,6 +101,7 @@ def main() -> int:
     ap.add_argument('-m', dest='marker', default='not ros and not lint',
                     help='pytest marker expression')
     ap.add_argument('-k', dest='keyword', default=None, help='pytest -k expression')
+    ap.add_argument('--workers', type=int, default=2, help='pytest-xdist workers per run')
     args = ap.parse_args()
     tmp = Path(tempfile.mkdtemp(prefix='hyst_id_roundoff_'))
     probes = [''] + [f'{k}:{args.size:g}' for k in range(1, args.runs + 1)]
@@ -107,7 +109,7 @@ def main() -> int:
     props = []
     for i, probe in enumerate(probes):
         xml_path = tmp / f'run{i}.xml'
-        run_suite(probe, xml_path, args.marker, args.keyword)
+        run_suite(probe, xml_path, args.marker, args.keyword, args.workers)
         if not xml_path.exists():
             print(f'[roundoff] run {i} wrote no report', file=sys.stderr)
             return 1
