@@ -41,16 +41,18 @@ from hyst_id.identification.gauge import canonical_gauge, output_sign
 from hyst_id.identification.quality import identification_warnings
 from hyst_id.identification.refine import refine
 from hyst_id.identification.result import Identification, IdentifySettings, SeedRun
+from hyst_id.identification.starts import data_starts
 from hyst_id.io.recording import Recording, roundoff_probe, validate_recording
 from hyst_id.signals.noise import noise_floor_percent
 from hyst_id.solvers.gaass import GaassSolver
 
-__all__ = ['identify', 'run_seed', 'summarise']
+__all__ = ['data_incumbent', 'identify', 'run_seed', 'summarise']
 
 
 def run_seed(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray, measurement: np.ndarray,
              settings: IdentifySettings, seed: int, floor_percent: float = 0.0,
-             on_generation: Callable[[int, int, int, float], Any] | None = None) -> SeedRun:
+             on_generation: Callable[[int, int, int, float], Any] | None = None,
+             incumbent: tuple[np.ndarray, float, int] | None = None) -> SeedRun:
     """Identify with one seed: GAASS, refinement, restarts; picklable for workers.
 
     The first GAASS run uses ``seed`` itself (the paper's procedure). With
@@ -62,15 +64,20 @@ def run_seed(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray, measurement:
     above 1.5 x the floor.
     ``on_generation(seed, restart, generation, er_percent)`` is called after
     every GAASS generation (it may raise to abandon the seed).
+    ``incumbent`` ``(x, cost, nfev)`` (the best polished data-built start,
+    :func:`data_incumbent`) is the result to beat from the start: a seed
+    whose GAASS runs all end in a worse basin returns it; its evaluations
+    are counted in this seed's ``nfev``.
     """
     with threadpool_limits(limits=1):   # parallelism is over seeds, not inside BLAS
         return _run_seed(spec, t_s, command, measurement, settings, seed, floor_percent,
-                         on_generation)
+                         on_generation, incumbent)
 
 
 def _run_seed(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray, measurement: np.ndarray,
               settings: IdentifySettings, seed: int, floor_percent: float,
-              on_generation: Callable[[int, int, int, float], Any] | None) -> SeedRun:
+              on_generation: Callable[[int, int, int, float], Any] | None,
+              incumbent: tuple[np.ndarray, float, int] | None = None) -> SeedRun:
     cost = spec.cost_function(t_s, command, measurement)
     sum_sq = float(np.sum(measurement ** 2))
     target = None
@@ -78,6 +85,8 @@ def _run_seed(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray, measurement
         target = (settings.er_bound_percent / 100.0) ** 2 * sum_sq
     good_enough = (settings.restart_factor * floor_percent / 100.0) ** 2 * sum_sq
     best_x, best_fun, er_ga, nfev, nit, history, message = None, np.inf, np.nan, 0, 0, None, ''
+    if incumbent is not None:
+        best_x, best_fun, nfev = np.asarray(incumbent[0], dtype=float), incumbent[1], incumbent[2]
     stalled = 0
     for restart in range(1 + (settings.restarts if settings.refine else 0)):
         rng = seed if restart == 0 else np.random.default_rng([seed, restart])
@@ -120,6 +129,45 @@ def _run_seed(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray, measurement
                    fun=float(best_fun),
                    er_percent=float(er_percent(best_fun, measurement)), er_gaass_percent=er_ga,
                    nfev=nfev, nit=nit, best_history=history, message=message)
+
+
+def data_incumbent(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray,
+                   measurement: np.ndarray, settings: IdentifySettings
+                   ) -> tuple[np.ndarray, float, int] | None:
+    """The best chain built from the data, polished: ``(x, cost, nfev)`` or None.
+
+    Every start of :func:`hyst_id.identification.starts.data_starts` (loop
+    width at the median crossing, flat inner lines, unit side slopes,
+    backlash shares, sensor time constants) gets a short polish, the best
+    two a full one. These starts lie outside the "linear H + backlash"
+    basin that a global search can fall into.
+    """
+    with threadpool_limits(limits=1):
+        try:
+            starts = data_starts(spec, t_s, command, measurement)
+        except (InvalidParametersError, ValueError):
+            return None
+        if not starts:
+            return None
+        short, nfev = [], 0
+        for x0 in starts:
+            x, fun, k = refine(spec, x0, t_s, command, measurement,
+                               max_nfev=_SHORT_POLISH * (spec.n_params + 1), restarts=0)
+            nfev += k
+            short.append((fun, x))
+        short.sort(key=lambda z: z[0])
+        best_x, best_fun = None, np.inf
+        for _, x0 in short[:2]:
+            x, fun, k = refine(spec, x0, t_s, command, measurement,
+                               max_nfev=settings.refine_max_nfev)
+            nfev += k
+            if fun < best_fun:
+                best_x, best_fun = x, fun
+    return (best_x, float(best_fun), nfev) if best_x is not None else None
+
+
+#: Evaluations per parameter (plus one) of the short polish of each data-built start.
+_SHORT_POLISH = 8
 
 
 def _report(on_generation: Callable[[int, int, int, float], Any] | None, seed: int,
@@ -207,18 +255,23 @@ def identify(recording: Recording, *, spec: ChainSpec | None = None,
         raise IdentificationError('no seeds given')
     floor = noise_floor_percent(rec.measurement)
     args = (spec, rec.t_s, rec.command, rec.measurement, settings)
+    incumbent = data_incumbent(*args) if settings.refine and settings.data_starts else None
+    # the shared start's evaluations are counted once, in the first seed
+    given = {s: (incumbent if k == 0 or incumbent is None else (*incumbent[:2], 0))
+             for k, s in enumerate(settings.seeds)}
     runs: list[SeedRun] = []
     n_workers = _n_workers(settings)
     if n_workers == 1:
         for seed in settings.seeds:
-            runs.append(run_seed(*args, seed, floor, on_generation))
+            runs.append(run_seed(*args, seed, floor, on_generation, given[seed]))
             if progress:
                 progress(len(runs), len(settings.seeds), runs[-1])
     else:
         # Limit BLAS threads in the parent too: forked children inherit its pools.
         with threadpool_limits(limits=1), ProcessPoolExecutor(
                 max_workers=n_workers, mp_context=_mp_context()) as pool:
-            futures = [pool.submit(run_seed, *args, seed, floor) for seed in settings.seeds]
+            futures = [pool.submit(run_seed, *args, seed, floor, None, given[seed])
+                       for seed in settings.seeds]
             try:
                 for fut in futures:
                     runs.append(fut.result())

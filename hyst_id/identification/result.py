@@ -62,6 +62,11 @@ class IdentifySettings:
         otherwise always pay for every restart).
     er_bound_percent : float or None
         Stop a GAASS run early once %e_r falls below this bound.
+    data_starts : bool
+        With refinement on, polish the chains built from the data once and
+        give every seed the best of them as the result to beat
+        (:func:`hyst_id.identification.driver.data_incumbent`). Off, or with
+        ``refine=False`` (the paper's procedure), seeds start from GAASS alone.
     """
 
     pop_size: int = 10
@@ -77,6 +82,7 @@ class IdentifySettings:
     restart_factor: float = 1.05
     restart_patience: int = 2
     er_bound_percent: float | None = None
+    data_starts: bool = True
 
 
 @dataclass

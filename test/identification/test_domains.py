@@ -216,10 +216,15 @@ def test_active_lines_of_the_true_loop():
 
 
 def test_narrow_domain_is_reported_on_its_edge(simulated):
-    """tau_s has no gauge freedom: a domain that excludes the truth (0.5 s) binds."""
+    """tau_s has no gauge freedom: a domain that excludes the truth (0.5 s) binds.
+
+    Four seeds: with two, one round-off probe in five stopped short of the best fit
+    with tau_s 2 % inside the edge (%e_r 1.195 x the floor; four seeds reach 1.18 x with
+    tau_s within 0.3 % of it under every probe tried).
+    """
     rec, _ = simulated('pressure')
     spec = chain_spec('pressure', domains={'tau_s': (1.0, 20.0)})
-    ident = identify(rec, spec=spec, settings=IdentifySettings(seeds=(0, 1), restarts=0))
+    ident = identify(rec, spec=spec, settings=IdentifySettings(seeds=(0, 1, 2, 3), restarts=0))
     warnings = domain_edge_warnings(ident, rec, spec)
     assert any(w.startswith('tau_s sits on the lower edge') for w in warnings), warnings
 
