@@ -24,8 +24,9 @@ the output span, A/D quantisation in about a third; any command and
 measurement units and offsets (a falling sensor in about a third); both
 initial states. The true noise floor is known from the simulation.
 
-Methods, each on the same recording and chain, in the box
-:func:`hyst_id.identification.domains.domains_from_data` derives:
+Methods, each on the same recording and chain (the box
+:func:`hyst_id.identification.domains.domains_from_data` derives, the initial
+state and sensor hold convention ``identify`` chose):
 
 * ``identify``: :func:`hyst_id.identify` with ``--seeds`` seeds (one process);
 * ``CMA-ES``: the ``cmaes`` package, IPOP restarts, at the evaluations
@@ -46,7 +47,7 @@ from __future__ import annotations
 
 import argparse
 from concurrent.futures import ProcessPoolExecutor
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 import os
 from pathlib import Path
 import sys
@@ -252,7 +253,8 @@ def run_case(index: int, methods: tuple[str, ...], seeds: int) -> dict:
         out['identify'] = (ident.er_percent / floor, nfev,
                            time.perf_counter() - t0)
         budget = nfev
-        spec = domains_from_data(rec)
+        # the same chain identify ended with: its box, initial state and sensor hold
+        spec = replace(domains_from_data(rec), initial=ident.initial, hold=ident.hold)
         for name, fn in (('CMA-ES', _cmaes), ('DE', _de)):
             if name in methods:
                 t0 = time.perf_counter()

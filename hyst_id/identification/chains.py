@@ -59,6 +59,8 @@ from hyst_id.models.sensors import first_order_coefficient, second_order_coeffic
 __all__ = [
     'CHAIN_NAMES',
     'CHANNELS',
+    'HOLDS',
+    'INITIAL_STATES',
     'PAPER_DOMAINS',
     'PARAM_UNITS',
     'SENSOR_NAMES',
@@ -73,6 +75,10 @@ CHANNELS = ('position', 'pressure', 'flow')
 #: Sensor-dynamics parameters of each channel.
 SENSOR_NAMES = {'position': (), 'pressure': ('tau_s',), 'flow': ('zeta', 'omega_n')}
 _KIND = {'position': 0, 'pressure': 1, 'flow': 2}
+#: States a chain can start in at the first sample (:attr:`ChainSpec.initial`).
+INITIAL_STATES = ('rising', 'falling')
+#: Zero-order-hold conventions of the sensor input (:attr:`ChainSpec.hold`).
+HOLDS = ('before', 'after')
 
 #: Units of the parameters that do not belong to H.
 TAIL_UNITS = {'m_bl': '1', 'c_bl': 'out', 'c_br': 'out', 'tau_s': 's', 'zeta': '1',
@@ -115,10 +121,16 @@ def _tail_feasible_rows(tail):
 
 
 @njit(cache=True)
-def _tail_signal(u, tail, kind, dt_s, uniform, out):
-    """Backlash and sensor dynamics after H's output ``u``, into ``out``."""
+def _tail_signal(u, tail, kind, dt_s, uniform, falling, hold_after, out):
+    """Backlash and sensor dynamics after H's output ``u``, into ``out``.
+
+    B starts on its rising edge, or on its falling one when ``falling``. The
+    sensor input of sample ``j`` is B's output at ``j`` (held over the
+    interval before it), or at ``j - 1`` when ``hold_after`` (held over the
+    interval after it: a sample does not yet see the command of its instant).
+    """
     m_bl, c_bl, c_br = tail[0], tail[1], tail[2]
-    y = m_bl * (u[0] - c_br)
+    y = m_bl * (u[0] - (c_bl if falling else c_br))
     out[0] = y
     n = u.shape[0]
     if kind == 0:
@@ -130,10 +142,11 @@ def _tail_signal(u, tail, kind, dt_s, uniform, out):
         a = first_order_coefficient(dt_s[1], tau)
         x = y
         for j in range(1, n):
+            y_prev = y
             y = backlash_step(u[j], y, m_bl, c_bl, c_br)
             if not uniform:
                 a = first_order_coefficient(dt_s[j], tau)
-            x = a * x + (1.0 - a) * y
+            x = a * x + (1.0 - a) * (y_prev if hold_after else y)
             out[j] = x
     else:
         zeta, omega = tail[3], tail[4]
@@ -141,11 +154,12 @@ def _tail_signal(u, tail, kind, dt_s, uniform, out):
         x = y
         xd = 0.0
         for j in range(1, n):
+            y_prev = y
             y = backlash_step(u[j], y, m_bl, c_bl, c_br)
             if not uniform:
                 p11, p12, p21, p22 = second_order_coefficients(dt_s[j], zeta, omega)
-            e = x - y
-            x = y + p11 * e + p12 * xd
+            e = x - (y_prev if hold_after else y)
+            x = (y_prev if hold_after else y) + p11 * e + p12 * xd
             xd = p21 * e + p22 * xd
             out[j] = x
 
@@ -190,14 +204,15 @@ def _sse(s, y, k, b):
 
 
 @njit(cache=True)
-def _tail_costs(u, tail, ok, kind, y, dt_s, uniform, profile, k_fixed, b_fixed, costs):
+def _tail_costs(u, tail, ok, kind, y, dt_s, uniform, falling, hold_after, profile, k_fixed,
+                b_fixed, costs):
     """Cost J (Eq. 6) of every row whose H output is ``u[i]``; infeasible rows cost inf."""
     s = np.empty(y.shape[0])
     for i in range(u.shape[0]):
         if not ok[i]:
             costs[i] = np.inf
             continue
-        _tail_signal(u[i], tail[i], kind, dt_s, uniform, s)
+        _tail_signal(u[i], tail[i], kind, dt_s, uniform, falling, hold_after, s)
         if profile:
             k, b, _ = _fit_affine(s, y)
             costs[i] = _sse(s, y, k, b)   # second pass: no cancellation
@@ -248,6 +263,18 @@ class ChainSpec:
         Scales of the data the domains were derived from.
     family : HysteresisFamily
         The hysteresis H (the paper's ``tk`` by default).
+    initial : {'rising', 'falling'}
+        State at the first sample: H and B on the rising boundary of their
+        loops (the model notes' suggestion, the default), or on the falling
+        one, as after a command that came down from far above. Another
+        simulator or a real rig may start either way
+        (:func:`hyst_id.identification.driver.identify` chooses).
+    hold : {'before', 'after'}
+        Zero-order-hold convention of the sensor's input: sample ``j``'s value
+        held over the interval before it (the default: the command changed
+        right after the previous sample) or after it (a sample is taken just
+        before the command of its instant acts). Simulators and loggers
+        differ; it matters when the sensor's time constant is a few samples.
     """
 
     channel: str
@@ -256,6 +283,32 @@ class ChainSpec:
     domain_source: str = 'paper'
     extra: dict = field(default_factory=dict)
     family: HysteresisFamily = field(default_factory=lambda: get_family(DEFAULT_FAMILY))
+    initial: str = 'rising'
+    hold: str = 'before'
+
+    def __post_init__(self) -> None:
+        if self.initial not in INITIAL_STATES:
+            raise ConfigError(f'initial state must be one of {INITIAL_STATES}, '
+                              f'got {self.initial!r}')
+        if self.hold not in HOLDS:
+            raise ConfigError(f'hold must be one of {HOLDS}, got {self.hold!r}')
+
+    @property
+    def falling(self) -> bool:
+        """Whether the chain starts on the falling boundary."""
+        return self.initial == 'falling'
+
+    def _h_command(self, v: np.ndarray) -> np.ndarray:
+        """H's command: with a falling start, one sample from far above comes first.
+
+        H starts on its rising boundary there (far up its top line) and falls
+        to ``v[0]``: exactly the falling boundary at ``v[0]``, for any family
+        whose branches are monotone. The extra output sample is dropped.
+        """
+        if not self.falling:
+            return v
+        far = float(np.max(v)) + 1e3 * max(float(np.ptp(v)), 1.0)
+        return np.ascontiguousarray(np.concatenate(([far], v)))
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -317,6 +370,7 @@ class ChainSpec:
         k, b = (1.0, 0.0) if profile else self.calibration
         nh, family = self.n_h, self.family
         block = max(1, _BLOCK_VALUES // max(1, v.shape[0]))
+        v_h, falling, hold_after = self._h_command(v), self.falling, self.hold == 'after'
 
         def cost(pop: np.ndarray) -> np.ndarray:
             pop = np.ascontiguousarray(np.atleast_2d(pop), dtype=np.float64)
@@ -326,10 +380,12 @@ class ChainSpec:
                 h = np.ascontiguousarray(rows[:, :nh])
                 tail = np.ascontiguousarray(rows[:, nh:])
                 ok = family.feasible_rows(h) & _tail_feasible_rows(tail)
-                u = np.empty((rows.shape[0], v.shape[0]))
-                family.simulate_rows(h, v, ok, u)
-                _tail_costs(u, tail, ok, kind, y, dt, uniform, profile, k, b,
-                            costs[a:a + block])
+                u = np.empty((rows.shape[0], v_h.shape[0]))
+                family.simulate_rows(h, v_h, ok, u)
+                if falling:
+                    u = np.ascontiguousarray(u[:, 1:])
+                _tail_costs(u, tail, ok, kind, y, dt, uniform, falling, hold_after, profile,
+                            k, b, costs[a:a + block])
             return costs
 
         return cost
@@ -339,10 +395,12 @@ class ChainSpec:
         p = self.check(params)
         v = np.ascontiguousarray(command, dtype=np.float64)
         dt, uniform = _intervals(t_s)
-        u = self.family.simulate(p[:self.n_h], v)
+        u = self.family.simulate(p[:self.n_h], self._h_command(v))
+        if self.falling:
+            u = np.ascontiguousarray(u[1:])
         out = np.empty(v.shape[0])
         _tail_signal(u, np.ascontiguousarray(p[self.n_h:]), _KIND[self.channel], dt, uniform,
-                     out)
+                     self.falling, self.hold == 'after', out)
         return out
 
     def residual(self, params: np.ndarray, t_s: np.ndarray, command: np.ndarray,
@@ -427,7 +485,8 @@ def _bounds_array(names: tuple[str, ...], bounds, base: np.ndarray | None,
 
 def chain_spec(channel: str, domains: Mapping[str, tuple[float, float]] | None = None,
                calibration: tuple[float, float] | None = None,
-               family: str | HysteresisFamily | None = None) -> ChainSpec:
+               family: str | HysteresisFamily | None = None,
+               initial: str = 'rising') -> ChainSpec:
     """Build the spec of a channel's chain.
 
     Parameters
@@ -446,12 +505,15 @@ def chain_spec(channel: str, domains: Mapping[str, tuple[float, float]] | None =
         command's scale whatever units the measurement has.
     family : str or HysteresisFamily, optional
         The hysteresis family (default ``tk``, the paper's).
+    initial : {'rising', 'falling'}
+        State at the first sample (:attr:`ChainSpec.initial`).
     """
     fam = get_family(family)
     names = chain_names(channel, fam)
     preset = {**dict(fam.paper_domains or {}), **TAIL_PAPER_DOMAINS}
     base = np.array([preset.get(n, (-1.0, 1.0)) for n in names], dtype=float)
-    spec = ChainSpec(channel=channel, bounds=base, calibration=calibration, family=fam)
+    spec = ChainSpec(channel=channel, bounds=base, calibration=calibration, family=fam,
+                     initial=initial)
     if domains:
         spec = spec.with_bounds(domains, source='given')
     return spec

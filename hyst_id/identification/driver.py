@@ -26,6 +26,7 @@ from __future__ import annotations
 
 from concurrent.futures import ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
+from dataclasses import replace
 import multiprocessing
 import os
 import threading
@@ -35,7 +36,13 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from hyst_id.errors import IdentificationError, InvalidParametersError
-from hyst_id.identification.chains import chain_spec, ChainSpec, er_percent
+from hyst_id.identification.chains import (
+    chain_spec,
+    ChainSpec,
+    er_percent,
+    HOLDS,
+    INITIAL_STATES,
+)
 from hyst_id.identification.domains import domains_from_data
 from hyst_id.identification.gauge import canonical_gauge, output_sign
 from hyst_id.identification.quality import identification_warnings
@@ -46,7 +53,7 @@ from hyst_id.io.recording import Recording, roundoff_probe, validate_recording
 from hyst_id.signals.noise import noise_floor_percent
 from hyst_id.solvers.gaass import GaassSolver
 
-__all__ = ['data_incumbent', 'identify', 'run_seed', 'summarise']
+__all__ = ['choose_conventions', 'data_incumbent', 'identify', 'run_seed', 'summarise']
 
 
 def run_seed(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray, measurement: np.ndarray,
@@ -166,6 +173,38 @@ def data_incumbent(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray,
     return (best_x, float(best_fun), nfev) if best_x is not None else None
 
 
+def choose_conventions(spec: ChainSpec, rec: Recording, incumbent: tuple[np.ndarray, float, int],
+                       settings: IdentifySettings
+                       ) -> tuple[ChainSpec, tuple[np.ndarray, float, int]]:
+    """The initial state and sensor hold convention that fit the recording best.
+
+    A recording made by another simulator or a real rig may start on the
+    falling boundary of the loop, and may sample its sensor before or after
+    the command of the same instant acts (:attr:`ChainSpec.initial`,
+    :attr:`ChainSpec.hold`). The incumbent is polished under every
+    combination (the hold only matters with sensor dynamics); another one
+    replaces the spec's only when it lowers the cost by more than 0.1 %, so
+    that a recording where they make no difference keeps the defaults.
+    """
+    holds = HOLDS if spec.channel != 'position' else (spec.hold,)
+    best_spec, (best_x, best_fun, nfev) = spec, incumbent
+    with threadpool_limits(limits=1):
+        for initial in INITIAL_STATES:
+            for hold in holds:
+                if (initial, hold) == (spec.initial, spec.hold):
+                    continue
+                trial = replace(spec, initial=initial, hold=hold)
+                x, fun, k = refine(trial, incumbent[0], rec.t_s, rec.command, rec.measurement,
+                                   max_nfev=settings.refine_max_nfev)
+                nfev += k
+                if fun < _CONVENTION_GAIN * best_fun:
+                    best_spec, best_x, best_fun = trial, x, fun
+    return best_spec, (best_x, float(best_fun), nfev)
+
+
+#: Another initial state or hold is taken only below this share of the current cost.
+_CONVENTION_GAIN = 0.999
+
 #: Evaluations per parameter (plus one) of the short polish of each data-built start.
 _SHORT_POLISH = 8
 
@@ -256,6 +295,9 @@ def identify(recording: Recording, *, spec: ChainSpec | None = None,
     floor = noise_floor_percent(rec.measurement)
     args = (spec, rec.t_s, rec.command, rec.measurement, settings)
     incumbent = data_incumbent(*args) if settings.refine and settings.data_starts else None
+    if incumbent is not None and settings.conventions == 'auto':
+        spec, incumbent = choose_conventions(spec, rec, incumbent, settings)
+        args = (spec, rec.t_s, rec.command, rec.measurement, settings)
     # the shared start's evaluations are counted once, in the first seed
     given = {s: (incumbent if k == 0 or incumbent is None else (*incumbent[:2], 0))
              for k, s in enumerate(settings.seeds)}
@@ -288,7 +330,8 @@ def summarise(rec: Recording, spec: ChainSpec, settings: IdentifySettings,
               runs: list[SeedRun]) -> Identification:
     """Combine seed runs into an :class:`Identification`."""
     best = min(runs, key=lambda r: r.fun)
-    canon = chain_spec(rec.channel, calibration=(best.sign, 0.0), family=spec.family)
+    canon = replace(chain_spec(rec.channel, calibration=(best.sign, 0.0), family=spec.family),
+                    initial=spec.initial, hold=spec.hold)
     warnings = []
     same_sign = [r for r in runs if r.sign == best.sign]
     if len(same_sign) < len(runs):
@@ -307,4 +350,5 @@ def summarise(rec: Recording, spec: ChainSpec, settings: IdentifySettings,
         er_mean_params_percent=er_mean,
         noise_floor_percent=noise_floor_percent(rec.measurement),
         runs=runs, bounds=spec.bounds, domain_source=spec.domain_source,
-        settings=settings, warnings=warnings, source=rec.source, family=spec.family.id)
+        settings=settings, warnings=warnings, source=rec.source, family=spec.family.id,
+        initial=spec.initial, hold=spec.hold)

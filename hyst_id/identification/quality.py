@@ -36,12 +36,14 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from hyst_id.errors import InvalidParametersError
-from hyst_id.identification.chains import chain_spec, ChainSpec
+from hyst_id.identification.chains import ChainSpec
 from hyst_id.identification.loop import loop_orientation, reversal_response
 from hyst_id.identification.refine import refine
 from hyst_id.identification.result import Identification
@@ -97,8 +99,7 @@ def identification_warnings(ident: Identification, rec: Recording,
         Warnings, most fundamental first.
     """
     if spec is None:
-        spec = chain_spec(ident.channel, family=ident.family).with_bounds(
-            ident.bounds, source=ident.domain_source)
+        spec = replace(ident.spec(), calibration=None)
     out = orientation_warnings(rec, _sign(ident))
     out += fit_warnings(ident)
     out += domain_edge_warnings(ident, rec, spec)
@@ -277,7 +278,7 @@ def _standard_errors(ident: Identification, rec: Recording, sign: float) -> dict
     Canonical parameters free: H (8), the backlash half width (``c_br = -c_bl``),
     sensor parameters. Covariance ``sigma^2 (J^T J)^+``.
     """
-    spec = chain_spec(ident.channel, calibration=(1.0, 0.0))
+    spec = replace(ident.spec(), calibration=(1.0, 0.0))
     x0 = np.asarray(ident.x, dtype=float)
     free = [i for i, n in enumerate(ident.names) if n not in ('m_bl', 'c_bl')]
     y = sign * np.asarray(rec.measurement, dtype=float)

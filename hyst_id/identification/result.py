@@ -22,7 +22,7 @@ here beyond building the JSON form and the chain spec of the result.
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
 
@@ -67,6 +67,11 @@ class IdentifySettings:
         give every seed the best of them as the result to beat
         (:func:`hyst_id.identification.driver.data_incumbent`). Off, or with
         ``refine=False`` (the paper's procedure), seeds start from GAASS alone.
+    conventions : {'auto', 'given'}
+        ``auto``: with data starts on, choose the chain's initial state and
+        sensor hold convention from the data
+        (:func:`hyst_id.identification.driver.choose_conventions`); ``given``:
+        keep the spec's.
     """
 
     pop_size: int = 10
@@ -83,6 +88,7 @@ class IdentifySettings:
     restart_patience: int = 2
     er_bound_percent: float | None = None
     data_starts: bool = True
+    conventions: str = 'auto'
 
 
 @dataclass
@@ -133,6 +139,9 @@ class Identification:
         Per-seed results.
     bounds : numpy.ndarray
         Search domains used.
+    initial, hold : str
+        The chain's initial state and sensor hold convention
+        (:attr:`hyst_id.identification.chains.ChainSpec.initial`, ``.hold``).
     """
 
     channel: str
@@ -150,6 +159,8 @@ class Identification:
     warnings: list[str] = field(default_factory=list)
     source: str = ''
     family: str = 'tk'
+    initial: str = 'rising'
+    hold: str = 'before'
 
     @property
     def x(self) -> np.ndarray:
@@ -158,8 +169,9 @@ class Identification:
 
     def spec(self) -> ChainSpec:
         """Chain spec that simulates the canonical parameters (calibration sign, 0)."""
-        return chain_spec(self.channel, calibration=(self.output_sign, 0.0),
-                          family=self.family).with_bounds(self.bounds, source=self.domain_source)
+        return replace(chain_spec(self.channel, calibration=(self.output_sign, 0.0),
+                                  family=self.family, initial=self.initial),
+                       hold=self.hold).with_bounds(self.bounds, source=self.domain_source)
 
     def to_dict(self) -> dict:
         """JSON-ready summary (arrays as lists)."""
@@ -170,6 +182,7 @@ class Identification:
                          'nfev': r.nfev, 'nit': r.nit, 'message': r.message})
         return {
             'channel': self.channel, 'family': self.family, 'source': self.source,
+            'initial_state': self.initial, 'sensor_hold': self.hold,
             'params': self.params, 'params_mean': self.params_mean,
             'output_sign': self.output_sign,
             'calibration': {'k': self.output_sign, 'b': 0.0,

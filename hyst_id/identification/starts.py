@@ -57,14 +57,15 @@ def box_of(spec: ChainSpec, t_s: np.ndarray, v: np.ndarray, y: np.ndarray) -> Lo
 def sensor_guesses(spec: ChainSpec, half_period_s: float) -> list[np.ndarray]:
     """Sensor parameters to combine with the data-built chains (inside the domains).
 
-    Pressure: a time constant of 0.05, 0.2 and 0.6 half periods; flow: damping
-    0.5 with a natural period of 0.1 and 0.4 half periods. Position: none.
+    Pressure: a time constant of 0.05, 0.2, 0.6 and 2 half periods; flow:
+    damping 0.5 with a natural period of 0.1, 0.4 and 1.5 half periods (a
+    sensor slower than a fast excitation is common). Position: none.
     """
     b = spec.bounds[spec.sensor_slice]
     if spec.channel == 'pressure':
-        out = [np.array([f * half_period_s]) for f in (0.05, 0.2, 0.6)]
+        out = [np.array([f * half_period_s]) for f in (0.05, 0.2, 0.6, 2.0)]
     elif spec.channel == 'flow':
-        out = [np.array([0.5, 2.0 * np.pi / (f * half_period_s)]) for f in (0.1, 0.4)]
+        out = [np.array([0.5, 2.0 * np.pi / (f * half_period_s)]) for f in (0.1, 0.4, 1.5)]
     else:
         return [np.zeros(0)]
     return [np.clip(x, b[:, 0], b[:, 1]) for x in out]

@@ -180,7 +180,8 @@ def test_sensor_domains_follow_timing(simulated, channel):
         assert bounds['omega_n'][0] < 0.6 < bounds['omega_n'][1] <= np.pi / 0.05
         assert fast_bounds['omega_n'][1] == pytest.approx(100.0 * bounds['omega_n'][1])
     else:
-        assert bounds['tau_s'][0] == 0.0 and 0.5 < bounds['tau_s'][1] < 10.0
+        # four half periods (~4.8 s each): a sensor slower than the excitation is common
+        assert bounds['tau_s'][0] == 0.0 and 0.5 < bounds['tau_s'][1] < 25.0
         assert fast_bounds['tau_s'][1] == pytest.approx(bounds['tau_s'][1] / 100.0)
 
 
