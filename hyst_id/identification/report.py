@@ -47,8 +47,11 @@ def format_table(ident: Identification, truth: dict | None = None) -> str:
     head = f'{"param":8s} {"unit":8s} {"mean":>11s} {"best":>11s} {"std":>9s}'
     if truth:
         head += f' {"true":>11s}'
+    convention = f'initial state: {ident.initial}'
+    if ident.channel != 'position':
+        convention += f', sensor input held {ident.hold} its sample'
     lines = [f'channel: {ident.channel}   seeds: {len(ident.runs)}   '
-             f'domains: {ident.domain_source}', head, '-' * len(head)]
+             f'domains: {ident.domain_source}   {convention}', head, '-' * len(head)]
     for i, name in enumerate(ident.names):
         row = (f'{name:8s} {PARAM_UNITS[name]:8s} {ident.params_mean[name]:11.4f} '
                f'{ident.params[name]:11.4f} {spread[i]:9.4f}')
