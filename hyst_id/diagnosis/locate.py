@@ -42,7 +42,7 @@ import numpy as np
 from scipy import signal as sps
 from scipy import stats
 
-from hyst_id.signals.noise import quantum
+from hyst_id.signals.noise import robust_noise_std as noise_std
 from hyst_id.signals.reversals import reversal_times
 
 __all__ = ['Localization', 'locate', 'newey_west_t', 'noise_std']
@@ -152,38 +152,6 @@ class Localization:
             'spectrum': clean(self.spectrum), 'features': self.features,
             'regions_s': [[float(a), float(b)] for a, b, _ in self.regions],
         }
-
-
-def noise_std(measurement: np.ndarray) -> float:
-    """Standard deviation of white measurement noise, robust to quantisation and jumps.
-
-    Unlike :func:`hyst_id.signals.noise.estimate_noise_std` (a trimmed RMS that drops
-    only the largest 5 % of the differences), this takes the median absolute
-    deviation of the differences of order 1, 2 and 3, so that a stick-slip
-    recording, where up to half the differences can be jumps, is still read
-    right (``Var = C(2d, d) sigma^2`` for
-    white noise), the smallest of the three (a smooth signal inflates the
-    low orders, kinks and jumps the high ones; the median ignores up to half
-    the samples being stick-slip jumps). On A/D-quantised data the MAD of
-    differences is itself one of a few quantised values and jumps between
-    them, so the data are first dithered with a seeded uniform noise of one
-    step, whose variance ``q^2 / 12`` is then subtracted.
-    """
-    y = np.asarray(measurement, dtype=np.float64)
-    q = quantum(y)
-    extra = 0.0
-    if q > 0:
-        y = y + np.random.default_rng(0).uniform(-0.5 * q, 0.5 * q, y.size)
-        extra = q * q / 12.0
-    est = []
-    for order, norm in ((1, 2.0), (2, 6.0), (3, 20.0)):
-        d = np.diff(y, n=order)
-        if d.size < 8:
-            continue
-        mad = float(np.median(np.abs(d - np.median(d))))
-        est.append(np.sqrt(max((1.4826 * mad) ** 2 / norm - extra, 0.0)))
-    sigma = float(min(est)) if est else float(np.std(y))
-    return max(sigma, q / np.sqrt(12.0))
 
 
 def newey_west_t(x: np.ndarray, y: np.ndarray, bandwidth: int) -> tuple[np.ndarray, np.ndarray]:

@@ -26,6 +26,11 @@ discrete values). The signal can only inflate each order's estimate, so the
 smallest of the three is taken. Heavily quantised sensors (many repeated
 values) get at least the quantisation noise ``q / sqrt(12)``.
 
+A second estimate, :func:`robust_noise_std`, takes medians instead (up to
+half the differences may be jumps, as in a stick-slip record) and dithers
+quantised data first; the diagnosis uses it. Both judge repeats and ties to
+round-off (:data:`REPEAT_TOLERANCE`), so a last-bit change does not move them.
+
 The noise floor is the %e_r (Eq. 7) a perfect model would score:
 ``sqrt(n sigma^2 / sum(y^2)) * 100``.
 """
@@ -37,7 +42,7 @@ from math import comb
 import numpy as np
 
 __all__ = ['estimate_noise_std', 'floor_percent', 'held_share', 'noise_floor_percent',
-           'quantum', 'REPEAT_TOLERANCE']
+           'quantum', 'REPEAT_TOLERANCE', 'robust_noise_std']
 
 #: Steps below this share of the signal's magnitude count as repeats: a value written
 #: through a unit conversion, or perturbed at round-off level, is still the same A/D count.
@@ -138,3 +143,35 @@ def floor_percent(measurement: np.ndarray, sigma: float) -> float:
     """
     y = np.asarray(measurement, dtype=np.float64)
     return float(np.sqrt(y.size * sigma ** 2 / max(float(y @ y), 1e-300)) * 100.0)
+
+
+def robust_noise_std(measurement: np.ndarray) -> float:
+    """Standard deviation of white measurement noise, robust to quantisation and jumps.
+
+    Unlike :func:`estimate_noise_std` (a trimmed RMS that drops only the
+    largest 5 % of the differences: the floor of identification), this takes the median absolute
+    deviation of the differences of order 1, 2 and 3, so that a stick-slip
+    recording, where up to half the differences can be jumps, is still read
+    right (``Var = C(2d, d) sigma^2`` for
+    white noise), the smallest of the three (a smooth signal inflates the
+    low orders, kinks and jumps the high ones; the median ignores up to half
+    the samples being stick-slip jumps). On A/D-quantised data the MAD of
+    differences is itself one of a few quantised values and jumps between
+    them, so the data are first dithered with a seeded uniform noise of one
+    step, whose variance ``q^2 / 12`` is then subtracted.
+    """
+    y = np.asarray(measurement, dtype=np.float64)
+    q = quantum(y)
+    extra = 0.0
+    if q > 0:
+        y = y + np.random.default_rng(0).uniform(-0.5 * q, 0.5 * q, y.size)
+        extra = q * q / 12.0
+    est = []
+    for order, norm in ((1, 2.0), (2, 6.0), (3, 20.0)):
+        d = np.diff(y, n=order)
+        if d.size < 8:
+            continue
+        mad = float(np.median(np.abs(d - np.median(d))))
+        est.append(np.sqrt(max((1.4826 * mad) ** 2 / norm - extra, 0.0)))
+    sigma = float(min(est)) if est else float(np.std(y))
+    return max(sigma, q / np.sqrt(12.0))

@@ -67,8 +67,7 @@ def test_quantised_data_read_the_same_after_round_off(probe_seed):
     change of 1e-12 per sample (another CPU make's arithmetic, or a unit
     conversion) removed them and the diagnosis read the noise 30 % low.
     """
-    from hyst_id.diagnosis.locate import noise_std
-    from hyst_id.signals.noise import quantum
+    from hyst_id.signals.noise import quantum, robust_noise_std as noise_std
     t = np.arange(0, 100, 0.05)
     q = 16.0 / 1024                      # 10 bits over 16 mA: steps longer than the noise
     clean = 9 + 2 * np.sin(2 * np.pi * t / 10)
