@@ -36,7 +36,6 @@ import os
 import signal
 import subprocess
 import sys
-import threading
 import time
 
 import numpy as np
@@ -70,7 +69,7 @@ def loopback(rate_hz: float, seconds: float, context, ref) -> dict:
     from rclpy.node import Node
     from std_msgs.msg import Float64
 
-    from hyst_id.nodes.support import COMMAND_QOS
+    from hyst_id.nodes.support import COMMAND_QOS, spin_in_background
 
     node = Node(f'latency_{int(rate_hz)}', context=context)
     pub = node.create_publisher(Float64, '/hyst_id/desired', COMMAND_QOS)
@@ -79,14 +78,7 @@ def loopback(rate_hz: float, seconds: float, context, ref) -> dict:
                              lambda m: recv.append((time.monotonic_ns(), m.data)), COMMAND_QOS)
     ex = SingleThreadedExecutor(context=context)
     ex.add_node(node)
-    spin = threading.Event()
-
-    def spinner() -> None:
-        while not spin.is_set():
-            ex.spin_once(timeout_sec=0.01)
-
-    thread = threading.Thread(target=spinner, daemon=True)
-    thread.start()
+    stop_spinning = spin_in_background(ex)
     deadline = time.monotonic() + 20.0
     while (pub.get_subscription_count() < 1 or node.count_publishers('/hyst_id/command') < 1) \
             and time.monotonic() < deadline:
@@ -107,8 +99,7 @@ def loopback(rate_hz: float, seconds: float, context, ref) -> dict:
         sent[k] = time.monotonic_ns()
         pub.publish(Float64(data=float(desired[k])))
     time.sleep(1.0)
-    spin.set()
-    thread.join(2.0)
+    stop_spinning()
     ex.remove_node(node)
     node.destroy_node()
     # Match each command to the desired sample it answers: the next sample, in order,

@@ -48,7 +48,6 @@ import os
 import signal
 import subprocess
 import sys
-import threading
 import time
 from typing import Any
 
@@ -99,7 +98,7 @@ def run_load(rate_hz: float = 1000.0, seconds: float = 60.0, update_every_s: flo
     from std_msgs.msg import Float64, String
 
     from hyst_id.nodes.compensator import ACTIVE_SET_QOS
-    from hyst_id.nodes.support import COMMAND_QOS, try_publish
+    from hyst_id.nodes.support import COMMAND_QOS, spin_in_background, try_publish
 
     proc = _start_compensator(log_path)
     context = rclpy.Context()
@@ -116,14 +115,7 @@ def run_load(rate_hz: float = 1000.0, seconds: float = 60.0, update_every_s: flo
                                 '/compensator/set_parameters_atomically')
     ex = SingleThreadedExecutor(context=context)
     ex.add_node(node)
-    stop = threading.Event()
-
-    def spinner() -> None:
-        while not stop.is_set():
-            ex.spin_once(timeout_sec=0.01)
-
-    thread = threading.Thread(target=spinner, daemon=True)
-    thread.start()
+    stop_spinning = spin_in_background(ex)
     try:
         deadline = time.monotonic() + 30.0
         while not (pub.get_subscription_count() >= 1 and client.service_is_ready() and sets
@@ -163,8 +155,7 @@ def run_load(rate_hz: float = 1000.0, seconds: float = 60.0, update_every_s: flo
             time.sleep(0.05)
         time.sleep(0.3)
     finally:
-        stop.set()
-        thread.join(2.0)
+        stop_spinning()
         proc.send_signal(signal.SIGINT)
         try:
             code = proc.wait(15)

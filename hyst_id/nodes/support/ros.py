@@ -23,7 +23,8 @@ from __future__ import annotations
 
 import importlib
 import sys
-from typing import Any, Mapping
+import threading
+from typing import Any, Callable, Mapping
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 import rclpy
@@ -34,7 +35,7 @@ from rclpy.node import Node
 from hyst_id.errors import ConfigError, HystIdError
 
 __all__ = ['diagnostic_array', 'first_line', 'init_ros', 'message_class', 'source_time_ns',
-           'spin_node', 'stamp_ns', 'try_publish']
+           'spin_in_background', 'spin_node', 'stamp_ns', 'try_publish']
 
 _RCLError = _rclpy.RCLError
 
@@ -149,3 +150,24 @@ def first_line(exc: BaseException) -> str:
     """First line of an exception's message (its type name when empty)."""
     text = str(exc).strip().splitlines()
     return text[0] if text else type(exc).__name__
+
+
+def spin_in_background(executor: Any) -> Callable[[], None]:
+    """Spin ``executor`` in a daemon thread until the returned ``stop()`` is called.
+
+    For scripts and tests that drive a graph from their own thread (benchmarks,
+    load tests); ``stop()`` ends the loop and joins the thread (2 s at most).
+    """
+    done = threading.Event()
+
+    def loop() -> None:
+        while not done.is_set():
+            executor.spin_once(timeout_sec=0.01)
+
+    thread = threading.Thread(target=loop, daemon=True)
+    thread.start()
+
+    def stop() -> None:
+        done.set()
+        thread.join(2.0)
+    return stop
