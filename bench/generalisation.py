@@ -112,9 +112,12 @@ def _excitation(kind: str, t: np.ndarray, rng: np.random.Generator) -> np.ndarra
 
 
 def _proper(p: dict) -> bool:
-    """A loop that does not cross itself: the left line left of the right one between
-    the bottom and top lines (corners: A left-bottom, B right-bottom, C right-top, D
-    left-top; A < B, D < C, A < D, B < C)."""
+    """Whether a loop does not cross itself.
+
+    The left line must lie left of the right one between the bottom and top
+    lines (corners: A left-bottom, B right-bottom, C right-top, D left-top;
+    A < B, D < C, A < D, B < C).
+    """
     a = (p['c_b'] + p['m_l'] * p['c_l']) / (p['m_l'] - p['m_b'])
     b = (p['c_b'] + p['m_r'] * p['c_r']) / (p['m_r'] - p['m_b'])
     c = (p['c_t'] + p['m_r'] * p['c_r']) / (p['m_r'] - p['m_t'])

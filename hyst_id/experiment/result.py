@@ -127,7 +127,8 @@ class ChannelResult:
     eps_c_raw_percent: float
     eps_c_percent: float           # position-equivalent
     position_rms_error: float      # measured position vs u_d, mA-eq
-    top_line_reached: bool
+    top_line_reached: bool         # the identified top line met inside the identification
+    #                                range by more than 1 % of its span
     eps_c_other_supply_percent: float = float('nan')  # same command, other supply setting
 
 
