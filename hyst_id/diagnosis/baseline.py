@@ -49,11 +49,16 @@ def structured_starts(spec: ChainSpec, t_s: np.ndarray, v: np.ndarray, y: np.nda
 
 def baseline_starts(rec_train: Recording, spec: ChainSpec, settings
                     ) -> tuple[np.ndarray, list[np.ndarray]]:
-    """GAASS result (few seeds, refined) and the data-built starts."""
+    """GAASS result (few seeds, refined) and the data-built starts.
+
+    The chain's conventions stay the spec's (``conventions='given'``): the
+    diagnosis's composed model starts on the rising boundary and holds the
+    sensor input before its sample, and its baseline must be fitted in them.
+    """
     ident_settings = IdentifySettings(pop_size=settings.pop_size, maxiter=settings.generations,
                                       seeds=tuple(settings.seeds), workers=settings.workers,
                                       refine=True, refine_top=2, restarts=1,
-                                      refine_max_nfev=1500)
+                                      refine_max_nfev=1500, conventions='given')
     ident = identify(rec_train, spec=spec, settings=ident_settings)
     x_ga = np.array(min(ident.runs, key=lambda r: r.fun).x_raw, dtype=float)
     return x_ga, structured_starts(spec, rec_train.t_s, rec_train.command,
