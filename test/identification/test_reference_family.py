@@ -12,7 +12,7 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
-"""The chains against the independent reference simulator, over a random family.
+"""The chains against the independent ``reference_sim`` package, over a random family.
 
 ``test/reference_sim`` is written apart from ``hyst_id.models`` (plain loops
 from the model notes). Over random parameter sets, excitations, sample
