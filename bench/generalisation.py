@@ -152,7 +152,10 @@ def _draw_params(channel: str, v: np.ndarray, rng: np.random.Generator,
         if channel == 'flow':
             p['zeta'] = rng.uniform(0.3, 0.95)   # underdamped (model notes, section 3)
             p['omega_n'] = 2 * np.pi / (rng.uniform(0.01, 0.05) * dur_s)
-        if paper_constraints_ok(p) and _proper(p) and band < 0.5 * span_u:
+        # the reference's check is strict on c_bl < c_br (as printed); "no backlash"
+        # (band 0) is a member of the family, so B is checked here with <=
+        h_only = {k: p[k] for k in ('m_l', 'm_r', 'm_t', 'm_b', 'c_l', 'c_r', 'c_t', 'c_b')}
+        if paper_constraints_ok(h_only) and _proper(p) and band < 0.5 * span_u:
             return p
     raise RuntimeError('no feasible parameter set drawn')
 

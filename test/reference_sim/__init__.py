@@ -12,12 +12,11 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
-"""A reference simulator of the paper's chain, written apart from ``hyst_id``.
+"""Reference simulator written apart from hyst_id; imports nothing from hyst_id.
 
-Plain numpy and Python loops straight from ``../shared/docs/model-notes.md``
-(the paper's Eq. 1, 8-10 as corrected there). It imports nothing from
-``hyst_id``: tests and ``bench/generalisation.py`` use it to make
-recordings that the package did not make.
+Plain numpy and Python loops straight from the seed paper (Eq. 1-3, 8-10) as
+corrected by ``shared/docs/model-notes.md``. Its modelling choices (initial
+state, zero-order hold, calibration) are listed in :mod:`reference_sim.sim`.
 """
 
 from __future__ import annotations
@@ -26,10 +25,11 @@ from .sim import (
     backlash,
     first_order_sensor,
     hysteresis,
+    loop_corners,
     paper_constraints_ok,
     second_order_sensor,
     simulate,
 )
 
-__all__ = ['backlash', 'first_order_sensor', 'hysteresis', 'paper_constraints_ok',
-           'second_order_sensor', 'simulate']
+__all__ = ['backlash', 'first_order_sensor', 'hysteresis', 'loop_corners',
+           'paper_constraints_ok', 'second_order_sensor', 'simulate']
