@@ -62,7 +62,8 @@ sys.path.insert(0, str(ROOT))
 from reference_sim import simulate as reference_simulate  # noqa: E402
 from reference_sim.sim import paper_constraints_ok  # noqa: E402
 
-__all__ = ['Case', 'draw_case', 'main', 'run_case']
+__all__ = ['Case', 'cmaes_minimise', 'draw_case', 'main', 'recording', 'run_case',
+           'true_floor']
 
 CHANNELS = ('position', 'pressure', 'flow')
 EXCITATIONS = ('decaying sine', 'multisine', 'chirp', 'random steps', 'minor loops')
@@ -160,13 +161,17 @@ def _draw_params(channel: str, v: np.ndarray, rng: np.random.Generator,
     raise RuntimeError('no feasible parameter set drawn')
 
 
-def draw_case(index: int, base_seed: int = 2026) -> Case:
-    """Recording ``index`` of the family (deterministic in ``index`` and ``base_seed``)."""
+def draw_case(index: int, base_seed: int = 2026, n_samples: int | None = None) -> Case:
+    """Recording ``index`` of the family (deterministic in ``index`` and ``base_seed``).
+
+    ``n_samples`` overrides the drawn length (the rest of the draw is unchanged).
+    """
     rng = np.random.default_rng([base_seed, index])
     channel = CHANNELS[index % 3]
     kind = EXCITATIONS[(index // 3) % len(EXCITATIONS)]
     dt = float(rng.choice([0.001, 0.005, 0.01, 0.02, 0.05, 0.1]))
     n = int(rng.integers(1000, 4001))
+    n = n if n_samples is None else int(n_samples)
     t = np.arange(n) * dt
     v = _excitation(kind, t, rng)
     p = _draw_params(channel, v, rng, n * dt)
@@ -191,25 +196,28 @@ def draw_case(index: int, base_seed: int = 2026) -> Case:
     return Case(index, channel, kind, dt, t, a * v + b, k * y + off, noise, p, note)
 
 
-def _recording(case: Case):
+def recording(case: Case):
+    """The case as a :class:`hyst_id.io.recording.Recording`."""
     from hyst_id.io.recording import Recording
     return Recording(case.t_s, case.command, case.measurement, case.channel, 'u', 'y',
                      f'reference family #{case.index}')
 
 
-def _true_floor(case: Case) -> float:
+def true_floor(case: Case) -> float:
+    """%e_r the true noise alone gives on the case."""
     from hyst_id.signals.noise import floor_percent
     return floor_percent(case.measurement, case.noise_std)
 
 
-def _cmaes(spec, rec, seed: int, budget: int) -> float:
+def cmaes_minimise(spec, rec, seed: int, budget: int) -> tuple[float, np.ndarray]:
+    """Plain CMA-ES (``cmaes``, IPOP restarts) on ``spec``'s cost: best J and its parameters."""
     from cmaes import CMA
     cost = spec.cost_function(rec.t_s, rec.command, rec.measurement)
     lo, width = spec.bounds[:, 0], spec.bounds[:, 1] - spec.bounds[:, 0]
     m = spec.n_params
     rng = np.random.default_rng(seed)
     penalty = 10.0 * float(np.sum((rec.measurement - rec.measurement.mean()) ** 2))
-    best, nfev, pop_size = np.inf, 0, None
+    best, best_x, nfev, pop_size = np.inf, None, 0, None
     while nfev < budget:
         opt = CMA(mean=rng.uniform(0.25, 0.75, m), sigma=0.25,
                   bounds=np.tile([0.0, 1.0], (m, 1)), seed=int(rng.integers(2 ** 31)),
@@ -222,10 +230,15 @@ def _cmaes(spec, rec, seed: int, budget: int) -> float:
             if ok.any():
                 values[ok] = cost(xs[ok])
             nfev += len(zs)
-            best = min(best, float(values.min()))
+            if float(values.min()) < best:
+                best, best_x = float(values.min()), xs[int(np.argmin(values))]
             opt.tell(list(zip(zs, values)))
         pop_size = opt.population_size * 2          # IPOP
-    return best
+    return best, best_x
+
+
+def _cmaes(spec, rec, seed: int, budget: int) -> float:
+    return cmaes_minimise(spec, rec, seed, budget)[0]
 
 
 def _de(spec, rec, seed: int, budget: int) -> float:
@@ -248,8 +261,8 @@ def run_case(index: int, methods: tuple[str, ...], seeds: int) -> dict:
     from hyst_id.identification.domains import domains_from_data
     from hyst_id.signals.noise import estimate_noise_std
     case = draw_case(index)
-    rec = _recording(case)
-    floor = _true_floor(case)
+    rec = recording(case)
+    floor = true_floor(case)
     out = {'index': index, 'note': case.note, 'floor': floor,
            'noise_error': estimate_noise_std(case.measurement) / case.noise_std - 1.0}
     with threadpool_limits(limits=1):

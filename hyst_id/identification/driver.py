@@ -53,13 +53,15 @@ from hyst_id.io.recording import Recording, roundoff_probe, validate_recording
 from hyst_id.signals.noise import noise_floor_percent
 from hyst_id.solvers.gaass import GaassSolver
 
-__all__ = ['choose_conventions', 'data_incumbent', 'identify', 'run_seed', 'summarise']
+__all__ = ['choose_conventions', 'data_incumbent', 'identify', 'rank_conventions', 'run_seed',
+           'summarise']
 
 
 def run_seed(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray, measurement: np.ndarray,
              settings: IdentifySettings, seed: int, floor_percent: float = 0.0,
              on_generation: Callable[[int, int, int, float], Any] | None = None,
-             incumbent: tuple[np.ndarray, float, int] | None = None) -> SeedRun:
+             incumbent: tuple[np.ndarray, float, int] | None = None,
+             alternates: tuple[ChainSpec, ...] = ()) -> SeedRun:
     """Identify with one seed: GAASS, refinement, restarts; picklable for workers.
 
     The first GAASS run uses ``seed`` itself (the paper's procedure). With
@@ -75,17 +77,26 @@ def run_seed(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray, measurement:
     :func:`data_incumbent`) is the result to beat from the start: a seed
     whose GAASS runs all end in a worse basin returns it; its evaluations
     are counted in this seed's ``nfev``.
+    ``alternates`` (the same chain under other initial states or sensor
+    holds, :func:`rank_conventions`) are searched in turn by the restarts
+    after the first: a recording whose conventions the data-built start
+    misjudged still reaches its basin. :func:`identify` rotates their order
+    from seed to seed, so that the first restarts of the seeds cover them
+    all. The run reports the conventions of the chain it ends with.
     """
     with threadpool_limits(limits=1):   # parallelism is over seeds, not inside BLAS
         return _run_seed(spec, t_s, command, measurement, settings, seed, floor_percent,
-                         on_generation, incumbent)
+                         on_generation, incumbent, alternates)
 
 
 def _run_seed(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray, measurement: np.ndarray,
               settings: IdentifySettings, seed: int, floor_percent: float,
               on_generation: Callable[[int, int, int, float], Any] | None,
-              incumbent: tuple[np.ndarray, float, int] | None = None) -> SeedRun:
-    cost = spec.cost_function(t_s, command, measurement)
+              incumbent: tuple[np.ndarray, float, int] | None = None,
+              alternates: tuple[ChainSpec, ...] = ()) -> SeedRun:
+    specs = (spec,) + tuple(alternates)
+    costs = [s.cost_function(t_s, command, measurement) for s in specs]
+    best_spec = spec
     sum_sq = float(np.sum(measurement ** 2))
     target = None
     if settings.er_bound_percent is not None:
@@ -97,7 +108,9 @@ def _run_seed(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray, measurement
     stalled = 0
     for restart in range(1 + (settings.restarts if settings.refine else 0)):
         rng = seed if restart == 0 else np.random.default_rng([seed, restart])
-        solver = GaassSolver(cost, spec.bounds, feasible=spec.feasible,
+        which = 0 if restart == 0 or len(specs) == 1 else 1 + (restart - 1) % (len(specs) - 1)
+        here, cost = specs[which], costs[which]
+        solver = GaassSolver(cost, here.bounds, feasible=here.feasible,
                              pop_size=settings.pop_size, maxiter=settings.maxiter, c=settings.c,
                              xi=settings.xi, target=target, rng=rng,
                              callback=_report(on_generation, seed, restart, measurement))
@@ -111,14 +124,15 @@ def _run_seed(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray, measurement
         if settings.refine:
             candidates = []
             for x0 in _distinct_best(res.population, res.population_fun, settings.refine_top):
-                x_ref, fun_ref, nfev_ref = refine(spec, x0, t_s, command, measurement,
+                x_ref, fun_ref, nfev_ref = refine(here, x0, t_s, command, measurement,
                                                   max_nfev=settings.refine_max_nfev)
                 nfev += nfev_ref
                 candidates.append((x_ref, fun_ref))
         previous = best_fun
         for x, fun in candidates:
-            if fun < best_fun:
-                best_x, best_fun = x, fun
+            # another convention must gain clearly, as in rank_conventions
+            if fun < (best_fun if here is best_spec else _CONVENTION_GAIN * best_fun):
+                best_x, best_fun, best_spec = x, fun, here
         if best_fun <= good_enough or (target is not None and best_fun <= target):
             break
         # far above the floor the model cannot reach it (unmodelled physics): stop once
@@ -127,15 +141,16 @@ def _run_seed(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray, measurement
         stalled = stalled + 1 if restart and far and best_fun > 0.99 * previous else 0
         if stalled >= settings.restart_patience:
             break
-    k, b = spec.fit_calibration(best_x, t_s, command, measurement)
+    k, b = best_spec.fit_calibration(best_x, t_s, command, measurement)
     if k == 0:
         raise IdentificationError('the best chain output does not vary: the measurement '
                                   'shows no response to the command')
-    x = canonical_gauge(best_x, (k, b), spec.family)
+    x = canonical_gauge(best_x, (k, b), best_spec.family)
     return SeedRun(seed=int(seed), x_raw=best_x, x=x, sign=output_sign((k, b)),
                    fun=float(best_fun),
                    er_percent=float(er_percent(best_fun, measurement)), er_gaass_percent=er_ga,
-                   nfev=nfev, nit=nit, best_history=history, message=message)
+                   nfev=nfev, nit=nit, best_history=history, message=message,
+                   initial=best_spec.initial, hold=best_spec.hold)
 
 
 def data_incumbent(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray,
@@ -173,21 +188,24 @@ def data_incumbent(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray,
     return (best_x, float(best_fun), nfev) if best_x is not None else None
 
 
-def choose_conventions(spec: ChainSpec, rec: Recording, incumbent: tuple[np.ndarray, float, int],
-                       settings: IdentifySettings
-                       ) -> tuple[ChainSpec, tuple[np.ndarray, float, int]]:
-    """The initial state and sensor hold convention that fit the recording best.
+def rank_conventions(spec: ChainSpec, rec: Recording, incumbent: tuple[np.ndarray, float, int],
+                     settings: IdentifySettings
+                     ) -> list[tuple[ChainSpec, tuple[np.ndarray, float, int]]]:
+    """Every initial state and sensor hold convention, best fitting first.
 
     A recording made by another simulator or a real rig may start on the
     falling boundary of the loop, and may sample its sensor before or after
     the command of the same instant acts (:attr:`ChainSpec.initial`,
     :attr:`ChainSpec.hold`). The incumbent is polished under every
     combination (the hold only matters with sensor dynamics); another one
-    replaces the spec's only when it lowers the cost by more than 0.1 %, so
-    that a recording where they make no difference keeps the defaults.
+    ranks above the spec's only when it lowers the cost by more than 0.1 %,
+    so that a recording where they make no difference keeps the defaults.
+    Each entry is ``(spec, (x, cost, nfev))``; the first entry's ``nfev``
+    counts every polish.
     """
     holds = HOLDS if spec.channel != 'position' else (spec.hold,)
-    best_spec, (best_x, best_fun, nfev) = spec, incumbent
+    ranked = [(spec, incumbent)]
+    nfev = incumbent[2]
     with threadpool_limits(limits=1):
         for initial in INITIAL_STATES:
             for hold in holds:
@@ -197,9 +215,20 @@ def choose_conventions(spec: ChainSpec, rec: Recording, incumbent: tuple[np.ndar
                 x, fun, k = refine(trial, incumbent[0], rec.t_s, rec.command, rec.measurement,
                                    max_nfev=settings.refine_max_nfev)
                 nfev += k
-                if fun < _CONVENTION_GAIN * best_fun:
-                    best_spec, best_x, best_fun = trial, x, fun
-    return best_spec, (best_x, float(best_fun), nfev)
+                ranked.append((trial, (x, float(fun), 0)))
+    clearly = [e for e in ranked[1:] if e[1][1] < _CONVENTION_GAIN * incumbent[1]]
+    winner = min(clearly, key=lambda e: e[1][1]) if clearly else ranked[0]
+    ranked = [winner] + sorted((e for e in ranked if e is not winner), key=lambda e: e[1][1])
+    first_spec, (x, fun, _) = ranked[0]
+    ranked[0] = (first_spec, (x, fun, nfev))
+    return ranked
+
+
+def choose_conventions(spec: ChainSpec, rec: Recording, incumbent: tuple[np.ndarray, float, int],
+                       settings: IdentifySettings
+                       ) -> tuple[ChainSpec, tuple[np.ndarray, float, int]]:
+    """The initial state and sensor hold convention that fit best (:func:`rank_conventions`)."""
+    return rank_conventions(spec, rec, incumbent, settings)[0]
 
 
 #: Another initial state or hold is taken only below this share of the current cost.
@@ -295,24 +324,32 @@ def identify(recording: Recording, *, spec: ChainSpec | None = None,
     floor = noise_floor_percent(rec.measurement)
     args = (spec, rec.t_s, rec.command, rec.measurement, settings)
     incumbent = data_incumbent(*args) if settings.refine and settings.data_starts else None
+    others: list[ChainSpec] = []
     if incumbent is not None and settings.conventions == 'auto':
-        spec, incumbent = choose_conventions(spec, rec, incumbent, settings)
+        ranked = rank_conventions(spec, rec, incumbent, settings)
+        spec, incumbent = ranked[0]
+        others = [e[0] for e in ranked[1:]] + [spec] if len(ranked) > 1 else []
         args = (spec, rec.t_s, rec.command, rec.measurement, settings)
     # the shared start's evaluations are counted once, in the first seed
     given = {s: (incumbent if k == 0 or incumbent is None else (*incumbent[:2], 0))
              for k, s in enumerate(settings.seeds)}
+    # restarts after the first try the other conventions, in an order rotated per seed
+    alternates = {s: tuple(others[k % len(others):] + others[:k % len(others)]) if others
+                  else () for k, s in enumerate(settings.seeds)}
     runs: list[SeedRun] = []
     n_workers = _n_workers(settings)
     if n_workers == 1:
         for seed in settings.seeds:
-            runs.append(run_seed(*args, seed, floor, on_generation, given[seed]))
+            runs.append(run_seed(*args, seed, floor, on_generation, given[seed],
+                                 alternates[seed]))
             if progress:
                 progress(len(runs), len(settings.seeds), runs[-1])
     else:
         # Limit BLAS threads in the parent too: forked children inherit its pools.
         with threadpool_limits(limits=1), ProcessPoolExecutor(
                 max_workers=n_workers, mp_context=_mp_context()) as pool:
-            futures = [pool.submit(run_seed, *args, seed, floor, None, given[seed])
+            futures = [pool.submit(run_seed, *args, seed, floor, None, given[seed],
+                                   alternates[seed])
                        for seed in settings.seeds]
             try:
                 for fut in futures:
@@ -330,12 +367,18 @@ def summarise(rec: Recording, spec: ChainSpec, settings: IdentifySettings,
               runs: list[SeedRun]) -> Identification:
     """Combine seed runs into an :class:`Identification`."""
     best = min(runs, key=lambda r: r.fun)
+    # the chain is the best run's: its initial state and sensor hold
+    spec = replace(spec, initial=best.initial, hold=best.hold)
     canon = replace(chain_spec(rec.channel, calibration=(best.sign, 0.0), family=spec.family),
                     initial=spec.initial, hold=spec.hold)
     warnings = []
-    same_sign = [r for r in runs if r.sign == best.sign]
-    if len(same_sign) < len(runs):
-        warnings.append(f'{len(runs) - len(same_sign)} seed(s) found the opposite sensor '
+    same_chain = [r for r in runs if (r.initial, r.hold) == (best.initial, best.hold)]
+    if len(same_chain) < len(runs):
+        warnings.append(f'{len(runs) - len(same_chain)} seed(s) ended with another initial '
+                        'state or sensor hold convention; they are left out of the mean')
+    same_sign = [r for r in same_chain if r.sign == best.sign]
+    if len(same_sign) < len(same_chain):
+        warnings.append(f'{len(same_chain) - len(same_sign)} seed(s) found the opposite sensor '
                         'gain sign; they are left out of the mean')
     xs = np.array([r.x for r in same_sign])
     x_mean = xs.mean(axis=0)

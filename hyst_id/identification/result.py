@@ -70,8 +70,8 @@ class IdentifySettings:
     conventions : {'auto', 'given'}
         ``auto``: with data starts on, choose the chain's initial state and
         sensor hold convention from the data
-        (:func:`hyst_id.identification.driver.choose_conventions`); ``given``:
-        keep the spec's.
+        (:func:`hyst_id.identification.driver.rank_conventions`; a seed's
+        odd restarts try the runner-up); ``given``: keep the spec's.
     """
 
     pop_size: int = 10
@@ -97,6 +97,9 @@ class SeedRun:
 
     ``sign`` is the canonical calibration gain (+1, or -1 for a sensor that
     falls as the actuator output rises): measurement = ``sign * chain(x)``.
+    ``initial`` and ``hold`` are the conventions of the chain ``x`` belongs to
+    (a seed's restarts may try the runner-up conventions, see
+    :func:`hyst_id.identification.driver.run_seed`).
     """
 
     seed: int
@@ -110,6 +113,8 @@ class SeedRun:
     nit: int
     best_history: np.ndarray
     message: str
+    initial: str = 'rising'
+    hold: str = 'before'
 
 
 @dataclass

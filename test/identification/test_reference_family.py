@@ -92,6 +92,6 @@ def test_identify_reaches_the_true_floor_on_the_reference_family(index, record_p
     # default seeds: with four, #1 ended at 1.34 x on one CPU make and 0.99 x on another;
     # with ten, 0.99-1.02 x under every round-off probe tried on all five
     ident = identify(rec, settings=IdentifySettings(workers=1))
-    ratio = ident.er_percent / FAMILY._true_floor(case)
+    ratio = ident.er_percent / FAMILY.true_floor(case)
     record_property('er_over_true_floor', round(ratio, 4))
     assert ratio <= 1.1, (case.note, ratio, ident.initial, ident.hold)
