@@ -196,24 +196,34 @@ def rank_conventions(spec: ChainSpec, rec: Recording, incumbent: tuple[np.ndarra
     A recording made by another simulator or a real rig may start on the
     falling boundary of the loop, and may sample its sensor before or after
     the command of the same instant acts (:attr:`ChainSpec.initial`,
-    :attr:`ChainSpec.hold`). The incumbent is polished under every
-    combination (the hold only matters with sensor dynamics); another one
-    ranks above the spec's only when it lowers the cost by more than 0.1 %,
-    so that a recording where they make no difference keeps the defaults.
-    Each entry is ``(spec, (x, cost, nfev))``; the first entry's ``nfev``
-    counts every polish.
+    :attr:`ChainSpec.hold`). The data-built starts depend on the initial
+    state, so :func:`data_incumbent` runs again under each other initial
+    state (``incumbent`` is the spec's own); every incumbent is then polished
+    under the other sensor hold (it only matters with sensor dynamics).
+    Another convention ranks above the spec's only when it lowers the cost by
+    more than 0.1 %, so that a recording where they make no difference keeps
+    the defaults. Each entry is ``(spec, (x, cost, nfev))``; the first
+    entry's ``nfev`` counts every evaluation made here.
     """
     holds = HOLDS if spec.channel != 'position' else (spec.hold,)
+    args = (rec.t_s, rec.command, rec.measurement)
     ranked = [(spec, incumbent)]
     nfev = incumbent[2]
     with threadpool_limits(limits=1):
         for initial in INITIAL_STATES:
-            for hold in holds:
-                if (initial, hold) == (spec.initial, spec.hold):
+            if initial != spec.initial:
+                trial = replace(spec, initial=initial)
+                found = data_incumbent(trial, *args, settings)
+                if found is None:
                     continue
-                trial = replace(spec, initial=initial, hold=hold)
-                x, fun, k = refine(trial, incumbent[0], rec.t_s, rec.command, rec.measurement,
-                                   max_nfev=settings.refine_max_nfev)
+                nfev += found[2]
+                ranked.append((trial, (found[0], found[1], 0)))
+        for base, (x0, _, _) in list(ranked):
+            for hold in holds:
+                if hold == base.hold:
+                    continue
+                trial = replace(base, hold=hold)
+                x, fun, k = refine(trial, x0, *args, max_nfev=settings.refine_max_nfev)
                 nfev += k
                 ranked.append((trial, (x, float(fun), 0)))
     clearly = [e for e in ranked[1:] if e[1][1] < _CONVENTION_GAIN * incumbent[1]]
