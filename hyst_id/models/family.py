@@ -186,8 +186,13 @@ class HysteresisFamily:
         """Search domain of every parameter for a loop living in ``box``."""
         raise NotImplementedError
 
-    def starts(self, box: LoopBox) -> list[np.ndarray]:
-        """Parameter sets built from the data (loop width, command range) to start from."""
+    def starts(self, box: LoopBox, width: float | None = None) -> list[np.ndarray]:
+        """Parameter sets built from the data to start from: loops of width ``width``.
+
+        ``width`` (command units) defaults to the measured ``box.loop_width``;
+        :func:`hyst_id.identification.starts.data_starts` asks for several
+        widths, sharing the measured one between H and the backlash.
+        """
         return []
 
     # ------------------------------------------------------------- inverse

@@ -23,7 +23,7 @@ Adding a family is one module defining a
 from __future__ import annotations
 
 from hyst_id.errors import ConfigError
-from hyst_id.models import tk
+from hyst_id.models import smooth, tk
 from hyst_id.models.family import HysteresisFamily
 
 __all__ = ['DEFAULT_FAMILY', 'FAMILIES', 'MODULES', 'get_family']
@@ -31,6 +31,7 @@ __all__ = ['DEFAULT_FAMILY', 'FAMILIES', 'MODULES', 'get_family']
 #: The family modules, in the order they are listed.
 MODULES = (
     tk,
+    smooth,
 )
 
 #: Every family by id.
