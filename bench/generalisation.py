@@ -41,6 +41,8 @@ with all methods)::
 
     python bench/generalisation.py --n 200 --workers 2
     python bench/generalisation.py --n 20 --methods identify --seeds 4
+    python bench/generalisation.py --jsonl runs.jsonl      # saves each recording
+    python bench/generalisation.py --summarise runs.jsonl  # the table from saved runs
 """
 
 from __future__ import annotations
@@ -48,6 +50,7 @@ from __future__ import annotations
 import argparse
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, replace
+import json
 import os
 from pathlib import Path
 import sys
@@ -312,8 +315,20 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument('--seeds', type=int, default=10, help='identify seeds')
     ap.add_argument('--methods', default='identify,CMA-ES,DE')
     ap.add_argument('--workers', type=int, default=os.cpu_count() or 1)
+    ap.add_argument('--jsonl', help='append one JSON line per recording to this file')
+    ap.add_argument('--summarise', nargs='+', metavar='JSONL',
+                    help='print the table from saved --jsonl files and run nothing')
     args = ap.parse_args(argv)
     methods = tuple(args.methods.split(','))
+    if args.summarise:
+        results = {}
+        for path in args.summarise:
+            with open(path) as fh:
+                for line in fh:
+                    r = json.loads(line)
+                    results[r['index']] = r
+        print(_summary([results[i] for i in sorted(results)], methods))
+        return 0
     results = []
     indices = range(args.start, args.start + args.n)
     with ProcessPoolExecutor(args.workers) as pool:
@@ -321,6 +336,9 @@ def main(argv: list[str] | None = None) -> int:
         for fut in futures:
             r = fut.result()
             results.append(r)
+            if args.jsonl:
+                with open(args.jsonl, 'a') as fh:
+                    fh.write(json.dumps(r) + '\n')
             cells = '  '.join(f'{m} {r[m][0]:.3f}' for m in ('identify', 'CMA-ES', 'DE')
                               if m in r)
             print(f'#{r["index"]:3d} {r["note"]}: {cells} (noise est {r["noise_error"]:+.0%})',
