@@ -95,6 +95,6 @@ def make_settings(args: argparse.Namespace) -> IdentifySettings:
         refine=not args.gaass_only, restarts=args.restarts, er_bound_percent=args.er_bound)
 
 
-def make_spec(args: argparse.Namespace, rec: Recording) -> ChainSpec:
-    """Chain spec with the search domains asked for (``--domains``)."""
-    return config.make_spec(rec, args.domains)
+def make_spec(args: argparse.Namespace, rec: Recording, family: str | None = None) -> ChainSpec:
+    """Chain spec with the search domains asked for (``--domains``) and H's ``family``."""
+    return config.make_spec(rec, args.domains, family=family)

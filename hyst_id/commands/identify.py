@@ -40,24 +40,40 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                          'DIR:write loop, residual and convergence figures (PNG) into DIR')
     parser.add_argument('--params-out', metavar='FILE',
                         help='write a ROS params file for the compensator node')
+    parser.add_argument('--model', default='tk', metavar='tk|smooth|auto',
+                        help="H's family: tk (the paper's piecewise-linear loop, default), "
+                        'smooth (Prandtl-Ishlinskii, curved branches) or auto (fit both on '
+                        'the first 70 %% of the duration, keep the lower held-out error, '
+                        'print both)')
 
 
 def run(args: argparse.Namespace) -> int:
     """Identify and print the report."""
+    from hyst_id.identification.domains import format_domains
+    from hyst_id.identification.model_choice import format_choice
     from hyst_id.identification.report import format_table, plot_identification, write_json
 
     rec = load_recording(args)
-    spec = make_spec(args, rec)
     settings = make_settings(args)
     print(f'{rec.source}: {rec.n_samples} samples over {rec.duration_s:.1f} s, '
           f'channel {rec.channel}', file=sys.stderr)
-    print('search domains (' + spec.domain_source + '): ' + ', '.join(
-        f'{n} [{lo:.4g}, {hi:.4g}]' for n, (lo, hi) in zip(spec.names, spec.bounds)),
-        file=sys.stderr)
-    ident = identify(rec, spec=spec, settings=settings, progress=_progress_bar(args, settings))
+    choice = None
+    if args.model == 'auto':
+        choice = _choose(args, rec, settings)
+        ident = choice.identification
+    else:
+        spec = make_spec(args, rec, family=args.model)
+        print(f'H family {spec.family.id}; search domains ({spec.domain_source}): '
+              + format_domains(spec), file=sys.stderr)
+        ident = identify(rec, spec=spec, settings=settings,
+                         progress=_progress_bar(args, settings))
     print(format_table(ident))
+    if choice is not None:
+        print()
+        print(format_choice(choice))
     if args.json:
-        write_json(ident, args.json)
+        write_json(ident, args.json, extra=None if choice is None
+                   else {'model_choice': choice.to_dict()})
         print(f'wrote {args.json}', file=sys.stderr)
     if args.plot:
         for path in plot_identification(ident, rec, args.plot):
@@ -69,17 +85,34 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _progress_bar(args: argparse.Namespace, settings):
+def _choose(args: argparse.Namespace, rec, settings):
+    from hyst_id.errors import ConfigError
+    from hyst_id.identification.model_choice import AUTO_FAMILIES, choose_family
+    if args.domains != 'auto':
+        raise ConfigError("--model auto derives each family's domains from the data; "
+                          '--domains must be auto')
+    bar = _progress_bar(args, settings, total=len(settings.seeds) * (len(AUTO_FAMILIES) + 1))
+
+    def stage(family: str, what: str) -> None:
+        part = 'the first 70 %' if what == 'train' else 'the whole recording'
+        print(f'{family}: identify on {part}', file=sys.stderr)
+
+    return choose_family(rec, AUTO_FAMILIES, settings=settings,
+                         progress=None if args.quiet else stage, seed_progress=bar)
+
+
+def _progress_bar(args: argparse.Namespace, settings,
+                  total: int | None = None):
     if getattr(args, 'quiet', False):
         return None
     from tqdm import tqdm
-    bar = tqdm(total=len(settings.seeds), desc='GAASS seeds', unit='seed', file=sys.stderr,
-               leave=False)
+    bar = tqdm(total=total or len(settings.seeds), desc='GAASS seeds', unit='seed',
+               file=sys.stderr, leave=False)
 
     def progress(done: int, total: int, run) -> None:
         bar.update(1)
         bar.set_postfix_str(f'seed {run.seed}: %e_r {run.er_percent:.3f}')
-        if done == total:
+        if bar.n >= bar.total:
             bar.close()
 
     return progress

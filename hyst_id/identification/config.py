@@ -30,6 +30,7 @@ from hyst_id.identification.domains import AUTO, domains_from_data, preset_spec,
 from hyst_id.identification.result import IdentifySettings
 from hyst_id.io.params_file import read_yaml
 from hyst_id.io.recording import Recording
+from hyst_id.models.registry import DEFAULT_FAMILY, get_family
 
 __all__ = ['make_settings', 'make_spec', 'read_domains_file']
 
@@ -67,7 +68,8 @@ def read_domains_file(path: str) -> dict[str, tuple[float, float]]:
         raise ConfigError(f'domains file {path}: each entry must be [low, high]') from None
 
 
-def make_spec(rec: Recording, domains: str | Mapping = AUTO) -> ChainSpec:
+def make_spec(rec: Recording, domains: str | Mapping = AUTO,
+              family: str | None = None) -> ChainSpec:
     """Chain spec for a recording with the search domains asked for.
 
     Parameters
@@ -77,11 +79,17 @@ def make_spec(rec: Recording, domains: str | Mapping = AUTO) -> ChainSpec:
     domains : str or mapping
         ``'auto'`` (derived from the data), a preset name (``'paper'``), a
         YAML file of overrides, or a mapping ``name -> (low, high)`` of overrides.
+    family : str, optional
+        H's family (default ``tk``, the paper's). Presets hold ``tk`` domains only.
     """
+    fam = get_family(family)
     if isinstance(domains, Mapping):
-        return domains_from_data(rec, overrides=domains)
+        return domains_from_data(rec, overrides=domains, family=fam)
     if domains == AUTO:
-        return domains_from_data(rec)
+        return domains_from_data(rec, family=fam)
     if domains in PRESETS:
+        if fam.id != DEFAULT_FAMILY:
+            raise ConfigError(f'the {domains!r} domain preset is for the {DEFAULT_FAMILY!r} '
+                              f'family, not {fam.id!r}; use auto or a YAML file')
         return preset_spec(domains, rec.channel)
-    return domains_from_data(rec, overrides=read_domains_file(domains))
+    return domains_from_data(rec, overrides=read_domains_file(domains), family=fam)

@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from hyst_id.identification import Identification
-from hyst_id.identification.chains import er_percent, PARAM_UNITS
+from hyst_id.identification.chains import er_percent, param_units
 from hyst_id.io.jsonable import jsonable
 from hyst_id.io.recording import Recording
 
@@ -50,10 +50,11 @@ def format_table(ident: Identification, truth: dict | None = None) -> str:
     convention = f'initial state: {ident.initial}'
     if ident.channel != 'position':
         convention += f', sensor input held {ident.hold} its sample'
-    lines = [f'channel: {ident.channel}   seeds: {len(ident.runs)}   '
+    units = param_units(ident.family)
+    lines = [f'channel: {ident.channel}   H family: {ident.family}   seeds: {len(ident.runs)}   '
              f'domains: {ident.domain_source}   {convention}', head, '-' * len(head)]
     for i, name in enumerate(ident.names):
-        row = (f'{name:8s} {PARAM_UNITS[name]:8s} {ident.params_mean[name]:11.4f} '
+        row = (f'{name:8s} {units[name]:8s} {ident.params_mean[name]:11.4f} '
                f'{ident.params[name]:11.4f} {spread[i]:9.4f}')
         if truth:
             row += f' {truth.get(name, float("nan")):11.4f}'

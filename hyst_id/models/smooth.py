@@ -20,21 +20,25 @@ saturating input map::
 
     g(v)  = v_s * tanh((v - v_c) / v_s)                  (saturation, command units)
     z_k   = play of threshold r_k = r_max * k / (N - 1) on g, k = 0 .. N - 1
-    u     = c_o + sum_k w_k z_k
+    u     = c_o + w_l (v - v_c) + sum_k w_k z_k
 
 with the play ``z_k <- max(g - r_k, min(g + r_k, z_k))``. ``k = 0`` has a
 zero threshold (the loop's reversible part), the others open the loop; the
 branches bend from the reversal points as more plays engage (the
 Prandtl-Ishlinskii shape), and ``g`` flattens them at the ends of the travel
 so that the branches of a wide loop close as a B(H) loop does (``v_s`` large:
-no saturation). :data:`N_PLAYS` plays.
+no saturation). ``w_l`` is a reversible slope on the raw command that the
+saturation leaves (a B(H) loop keeps rising past the knee; ``w_l = 0``: the
+output saturates). :data:`N_PLAYS` plays.
 
-Exact inverse. With ``w_0 > 0`` and ``w_k >= 0`` every branch is strictly
-increasing in ``v`` (``g`` is), so for a desired output the play sum is a
-piecewise-linear increasing function of ``g`` from the present state, solved
-in closed form segment by segment, and ``v = v_c + v_s atanh(g / v_s)``
-(:class:`SmoothInverse`; round-off exact). Outputs beyond the saturation
-are not reachable: the inverse returns the nearest reachable command.
+Exact inverse. With ``w_0 > 0`` and ``w_k, w_l >= 0`` every branch is
+strictly increasing in ``v`` (``g`` is), so for a desired output the play sum
+is a piecewise-linear increasing function of ``g`` from the present state: the
+segment holding the target is found by walking the breakpoints, then
+``v = v_c + v_s atanh(g / v_s)`` in closed form (``w_l = 0``) or a bracketed
+Newton solve of one monotone scalar equation on that segment (``w_l > 0``),
+both to round-off (:class:`SmoothInverse`). With ``w_l = 0`` outputs beyond
+the saturation are not reachable: the inverse returns the nearest reachable command.
 
 Conventions as every family (:mod:`hyst_id.models.family`): the state starts
 on the rising boundary at the first command (``z_k = g(v_0) - r_k``).
@@ -55,25 +59,27 @@ __all__ = ['FAMILY', 'N_PLAYS', 'SMOOTH_NAMES', 'Smooth', 'SmoothInverse', 'smoo
 #: Number of play operators (thresholds ``r_max * k / (N_PLAYS - 1)``).
 N_PLAYS = 6
 WEIGHT_NAMES = tuple(f'w_{k}' for k in range(N_PLAYS))
-SMOOTH_NAMES = WEIGHT_NAMES + ('r_max', 'v_s', 'v_c', 'c_o')
-UNITS = {**dict.fromkeys(WEIGHT_NAMES, 'out/cmd'), 'r_max': 'cmd', 'v_s': 'cmd', 'v_c': 'cmd',
-         'c_o': 'out'}
+SMOOTH_NAMES = WEIGHT_NAMES + ('w_l', 'r_max', 'v_s', 'v_c', 'c_o')
+UNITS = {**dict.fromkeys(WEIGHT_NAMES, 'out/cmd'), 'w_l': 'out/cmd', 'r_max': 'cmd',
+         'v_s': 'cmd', 'v_c': 'cmd', 'c_o': 'out'}
+# vector positions after the play weights
+_WL, _RMAX, _VS, _VC, _CO = range(N_PLAYS, N_PLAYS + 5)
 #: Largest |g / v_s| the inverse aims at (atanh stays finite).
 _G_EDGE = 1.0 - 1e-12
 
 
 @njit(cache=True)
 def smooth_feasible(p):
-    """True when ``p`` is a valid set: ``w_0 > 0``, ``w_k >= 0``, ``r_max >= 0``, ``v_s > 0``."""
+    """True when ``p`` is a valid set: ``w_0 > 0``, ``w_k, w_l, r_max >= 0``, ``v_s > 0``."""
     for i in range(p.shape[0]):
         if not np.isfinite(p[i]):
             return False
     if not p[0] > 0.0:
         return False
-    for k in range(1, N_PLAYS):
+    for k in range(1, N_PLAYS + 1):
         if p[k] < 0.0:
             return False
-    return p[N_PLAYS] >= 0.0 and p[N_PLAYS + 1] > 0.0
+    return p[_RMAX] >= 0.0 and p[_VS] > 0.0
 
 
 @njit(cache=True)
@@ -92,8 +98,8 @@ def _simulate_rows(pop, v, ok, out):
     for i in range(pop.shape[0]):
         if not ok[i]:
             continue
-        r_max, v_s, v_c, c_o = pop[i, N_PLAYS], pop[i, N_PLAYS + 1], pop[i, N_PLAYS + 2], \
-            pop[i, N_PLAYS + 3]
+        w_l, r_max, v_s = pop[i, _WL], pop[i, _RMAX], pop[i, _VS]
+        v_c, c_o = pop[i, _VC], pop[i, _CO]
         for k in range(N_PLAYS):
             r[k] = r_max * k / (N_PLAYS - 1)
         g = v_s * math.tanh((v[0] - v_c) / v_s)
@@ -101,7 +107,7 @@ def _simulate_rows(pop, v, ok, out):
             z[k] = g - r[k]                            # rising boundary
         for j in range(n):
             g = v_s * math.tanh((v[j] - v_c) / v_s)
-            acc = c_o
+            acc = c_o + w_l * (v[j] - v_c)
             for k in range(N_PLAYS):
                 zk = min(g + r[k], z[k])
                 zk = max(g - r[k], zk)
@@ -110,29 +116,83 @@ def _simulate_rows(pop, v, ok, out):
             out[i, j] = acc
 
 
-def _play_sum_target(w: np.ndarray, r: np.ndarray, z: np.ndarray, g0: float,
-                     target: float) -> float:
-    """The ``g`` from ``g0`` where ``sum_k w_k play_k(g) = target`` (piecewise linear)."""
-    now = float(w @ z)
-    if target == now:
-        return g0
-    up = target > now
+def _solve_command(w: np.ndarray, r: np.ndarray, z: np.ndarray, v0: float, g0: float,
+                   shape: tuple[float, float, float], target: float) -> float:
+    """The command from ``v0`` where ``w_l (v - v_c) + sum_k w_k play_k(g(v)) = target``.
+
+    ``shape`` is ``(w_l, v_s, v_c)``. The play sum is piecewise linear in ``g``;
+    walk its breakpoints from the present state to the segment holding the
+    target, then solve on that segment (closed form with ``w_l = 0``, else a
+    bracketed Newton iteration on a strictly increasing function).
+    """
+    w_l, v_s, v_c = shape
+    s_now = float(w @ z)
+    if target == s_now + w_l * (v0 - v_c):
+        return v0
+    up = target > s_now + w_l * (v0 - v_c)
     # play k starts moving once g passes its breakpoint: z_k + r_k (up) or z_k - r_k (down)
     brk = z + r if up else z - r
     order = np.argsort(brk) if up else np.argsort(-brk)
     engaged = (brk <= g0) if up else (brk >= g0)
-    g, value, slope = g0, now, float(w[engaged].sum())
+    g, v, value, slope = g0, v0, s_now, float(w[engaged].sum())
+    v_end = math.inf if up else -math.inf
     for k in order:
         if engaged[k]:
             continue
         b = float(brk[k])
-        # run to the next breakpoint with the present slope
-        reach = value + slope * (b - g)
-        if (up and reach >= target) or (not up and reach <= target):
+        if abs(b) >= v_s:          # g never gets there
             break
-        g, value = b, reach
+        v_b = _v_of_g(b, v_s, v_c)
+        reach = value + slope * (b - g)
+        if (up and reach + w_l * (v_b - v_c) >= target) or \
+                (not up and reach + w_l * (v_b - v_c) <= target):
+            v_end = v_b
+            break
+        g, v, value = b, v_b, reach
         slope += float(w[k])
-    return g + (target - value) / slope
+    if w_l == 0.0:
+        return _v_of_g(g + (target - value) / slope, v_s, v_c)
+    return _newton_on_segment(g, v, value, slope, (w_l, v_s, v_c), target, v_end)
+
+
+def _v_of_g(g: float, v_s: float, v_c: float) -> float:
+    x = min(max(g / v_s, -_G_EDGE), _G_EDGE)
+    return v_c + v_s * math.atanh(x)
+
+
+def _newton_on_segment(g0: float, v0: float, value: float, slope: float,
+                       shape: tuple[float, float, float], target: float,
+                       v_end: float) -> float:
+    """Root of ``value + slope (g(v) - g0) + w_l (v - v_c) - target`` between v0 and v_end."""
+    w_l, v_s, v_c = shape
+
+    def f(v: float) -> float:
+        return value + slope * (v_s * math.tanh((v - v_c) / v_s) - g0) + w_l * (v - v_c) - target
+
+    f0 = f(v0)
+    up = v_end > v0
+    if (f0 >= 0.0) if up else (f0 <= 0.0):
+        return v0                  # there already, to round-off
+    # the slope is at least w_l, so the root lies within |f0| / w_l of v0
+    lo, hi = (v0, min(v_end, v0 - f0 / w_l)) if up else (max(v_end, v0 - f0 / w_l), v0)
+    x = 0.5 * (lo + hi)
+    for _ in range(100):
+        fx = f(x)
+        if fx == 0.0:
+            return x
+        if fx < 0:
+            lo = x
+        else:
+            hi = x
+        th = math.tanh((x - v_c) / v_s)
+        step = fx / (slope * (1.0 - th * th) + w_l)
+        x_new = x - step
+        if not lo < x_new < hi:
+            x_new = 0.5 * (lo + hi)
+        if abs(x_new - x) <= 4e-16 * max(1.0, abs(x)) or hi - lo <= 4e-16 * max(1.0, abs(x)):
+            return x_new
+        x = x_new
+    return x
 
 
 class SmoothInverse(HysteresisInverse):
@@ -141,7 +201,7 @@ class SmoothInverse(HysteresisInverse):
     def __init__(self, params: np.ndarray):
         p = np.asarray(params, dtype=float)
         self.w = p[:N_PLAYS].copy()
-        self.r_max, self.v_s, self.v_c, self.c_o = (float(x) for x in p[N_PLAYS:])
+        self.w_l, self.r_max, self.v_s, self.v_c, self.c_o = (float(x) for x in p[N_PLAYS:])
         self.r = self.r_max * np.arange(N_PLAYS) / (N_PLAYS - 1)
         self.z = np.zeros(N_PLAYS)
         self.reset(0.0)
@@ -168,17 +228,14 @@ class SmoothInverse(HysteresisInverse):
     @property
     def output(self) -> float:
         """H's output in the state."""
-        return self.c_o + float(self.w @ self.z)
+        return self.c_o + self.w_l * (self.v - self.v_c) + float(self.w @ self.z)
 
     def command_for(self, u_d: float) -> float:
         """Command that makes H output ``u_d`` next (nearest reachable beyond saturation)."""
         if not math.isfinite(u_d):
             return self.v
-        g = _play_sum_target(self.w, self.r, self.z, self.g, float(u_d) - self.c_o)
-        if g == self.g:
-            return self.v
-        x = min(max(g / self.v_s, -_G_EDGE), _G_EDGE)
-        return self.v_c + self.v_s * math.atanh(x)
+        return _solve_command(self.w, self.r, self.z, self.v, self.g,
+                              (self.w_l, self.v_s, self.v_c), float(u_d) - self.c_o)
 
     def advance(self, v: float) -> float:
         """Move the state with command ``v``; return H's output."""
@@ -198,7 +255,7 @@ class Smooth(HysteresisFamily):
     units = UNITS
 
     def check(self, params: np.ndarray) -> np.ndarray:
-        """Validate a set (finite; ``w_0 > 0``, ``w_k >= 0``, ``r_max >= 0``, ``v_s > 0``)."""
+        """Validate a set (finite; ``w_0 > 0``, ``w_k, w_l, r_max >= 0``, ``v_s > 0``)."""
         p = np.asarray(params, dtype=np.float64).ravel()
         if p.shape[0] != len(SMOOTH_NAMES):
             raise InvalidParametersError(f'the smooth family needs {len(SMOOTH_NAMES)} '
@@ -209,9 +266,11 @@ class Smooth(HysteresisFamily):
             raise InvalidParametersError('w_0 must be > 0 (strictly increasing branches)')
         if np.any(p[1:N_PLAYS] < 0):
             raise InvalidParametersError('play weights w_k must be >= 0')
-        if p[N_PLAYS] < 0:
+        if p[_WL] < 0:
+            raise InvalidParametersError('w_l must be >= 0')
+        if p[_RMAX] < 0:
             raise InvalidParametersError('r_max must be >= 0')
-        if not p[N_PLAYS + 1] > 0:
+        if not p[_VS] > 0:
             raise InvalidParametersError('v_s must be > 0')
         return np.ascontiguousarray(p)
 
@@ -228,16 +287,16 @@ class Smooth(HysteresisFamily):
     def map_output(self, params: np.ndarray, alpha: float, delta: float) -> np.ndarray:
         """Parameters of ``alpha * H + delta``: weights scale, the offset maps."""
         p = np.array(params, dtype=np.float64)
-        p[:N_PLAYS] *= alpha
-        p[N_PLAYS + 3] = alpha * p[N_PLAYS + 3] + delta
+        p[:_WL + 1] *= alpha
+        p[_CO] = alpha * p[_CO] + delta
         return p
 
     def domains(self, box: LoopBox) -> dict[str, tuple[float, float]]:
-        """Weights up to the steepest slope, thresholds up to the span, saturation 0.1-20 spans."""
+        """Weights to the steepest slope, thresholds to the span, saturation 0.01-20 spans."""
         span_v = max(box.span_v, 1e-12)
         w_hi = box.steep * box.slope
-        out = {n: (0.0, w_hi) for n in WEIGHT_NAMES}
-        out.update({'r_max': (0.0, span_v), 'v_s': (0.1 * span_v, 20.0 * span_v),
+        out = {n: (0.0, w_hi) for n in WEIGHT_NAMES + ('w_l',)}
+        out.update({'r_max': (0.0, span_v), 'v_s': (0.01 * span_v, 20.0 * span_v),
                     'v_c': (box.v_min, box.v_max),
                     'c_o': (box.u_lo - box.span_u, box.u_hi + box.span_u)})
         return out
@@ -255,7 +314,7 @@ class Smooth(HysteresisFamily):
         for profile in (np.ones(N_PLAYS), np.linspace(2.0, 0.2, N_PLAYS)):
             w = box.slope * profile / profile.sum()
             for v_s in (20.0 * span_v, 0.5 * span_v):
-                out.append(np.concatenate([w, [max(w_loop, 1e-9 * span_v), v_s, v_mid,
+                out.append(np.concatenate([w, [0.0, max(w_loop, 1e-9 * span_v), v_s, v_mid,
                                                u_mid]]))
         return out
 
@@ -266,10 +325,11 @@ class Smooth(HysteresisFamily):
     def describe(self, params: np.ndarray) -> dict[str, float]:
         """Loop width of the plays in the linear limit, and the saturation's reach."""
         p = self.check(params)
-        r = p[N_PLAYS] * np.arange(N_PLAYS) / (N_PLAYS - 1)
+        r = p[_RMAX] * np.arange(N_PLAYS) / (N_PLAYS - 1)
         total = float(p[:N_PLAYS].sum())
         return {'loop_width_cmd': float(2.0 * (p[:N_PLAYS] @ r) / total) if total else 0.0,
-                'total_slope': total, 'saturation_cmd': float(p[N_PLAYS + 1])}
+                'total_slope': total + float(p[_WL]), 'saturation_cmd': float(p[_VS]),
+                'slope_past_saturation': float(p[_WL])}
 
 
 #: The family the registry lists.

@@ -26,42 +26,18 @@ import math
 
 import numpy as np
 import pytest
-from reference_sim import backlash, first_order_sensor
+from smooth_reference import plain_play_sum, random_params, smooth_recording
 
 from hyst_id.compensation import Compensator, InverseModel
 from hyst_id.errors import InvalidParametersError
 from hyst_id.identification import identify, IdentifySettings
 from hyst_id.identification.domains import domains_from_data
-from hyst_id.io.recording import Recording
 from hyst_id.models.registry import get_family
 from hyst_id.models.smooth import N_PLAYS, SMOOTH_NAMES
 
 __all__: list[str] = []
 
 FAMILY = get_family('smooth')
-
-
-def plain_play_sum(p, v):
-    """The smooth family's H from its formula, one sample and one play at a time."""
-    w = [float(x) for x in p[:N_PLAYS]]
-    r_max, v_s, v_c, c_o = (float(x) for x in p[N_PLAYS:])
-    r = [r_max * k / (N_PLAYS - 1) for k in range(N_PLAYS)]
-    g = v_s * math.tanh((float(v[0]) - v_c) / v_s)
-    z = [g - rk for rk in r]
-    out = []
-    for x in v:
-        g = v_s * math.tanh((float(x) - v_c) / v_s)
-        z = [max(g - rk, min(g + rk, zk)) for zk, rk in zip(z, r)]
-        out.append(c_o + sum(wk * zk for wk, zk in zip(w, z)))
-    return np.array(out)
-
-
-def random_params(rng):
-    """A valid set: some weights zero, wide and narrow thresholds, weak and strong saturation."""
-    w = rng.uniform(0.0, 2.0, N_PLAYS) * (rng.uniform(size=N_PLAYS) < 0.7)
-    w[0] = rng.uniform(0.05, 2.0)
-    return np.concatenate([w, [rng.uniform(0.0, 3.0), math.exp(rng.uniform(-1.0, 3.0)),
-                               rng.uniform(-1.0, 1.0), rng.uniform(-5.0, 5.0)]])
 
 
 @pytest.mark.parametrize('seed', range(40))
@@ -94,8 +70,24 @@ def test_inverse_round_trip(seed):
     assert worst <= 1e-9 * max(1.0, np.ptp(targets))
 
 
+@pytest.mark.parametrize('seed', range(20))
+def test_inverse_reaches_any_target_with_a_slope_past_saturation(seed):
+    """With ``w_l > 0`` every output is reachable: random targets far past the knee."""
+    rng = np.random.default_rng([9, seed])
+    p = random_params(rng)
+    p[SMOOTH_NAMES.index('w_l')] = math.exp(rng.uniform(-4.0, 0.0))
+    inv = FAMILY.inverse(p)
+    inv.reset(0.0)
+    span = 10.0 * float(p[:N_PLAYS + 1].sum() * p[SMOOTH_NAMES.index('v_s')] + 1.0)
+    worst = 0.0
+    for u in np.cumsum(rng.normal(0.0, 0.05 * span, 300)):
+        inv.advance(inv.command_for(float(u)))
+        worst = max(worst, abs(inv.output - u) / max(1.0, abs(u)))
+    assert worst <= 1e-9
+
+
 def test_inverse_beyond_saturation_goes_to_the_nearest_reachable():
-    p = np.array([1.0, 0, 0, 0, 0, 0, 0.0, 1.0, 0.0, 0.0])       # u = tanh(v)
+    p = np.array([1.0, 0, 0, 0, 0, 0, 0.0, 0.0, 1.0, 0.0, 0.0])       # u = tanh(v)
     inv = FAMILY.inverse(p)
     v = inv.command_for(5.0)
     assert math.isfinite(v) and v > 10.0
@@ -115,9 +107,9 @@ def test_output_map_is_the_gauge(seed):
 
 @pytest.mark.parametrize('bad, rule', [
     ({'w_0': 0.0}, 'w_0'), ({'w_3': -0.1}, 'w_k'), ({'r_max': -1.0}, 'r_max'),
-    ({'v_s': 0.0}, 'v_s'), ({'c_o': float('nan')}, 'finite')])
+    ({'v_s': 0.0}, 'v_s'), ({'c_o': float('nan')}, 'finite'), ({'w_l': -0.1}, 'w_l')])
 def test_invalid_sets_are_refused_by_name(bad, rule):
-    p = dict(zip(SMOOTH_NAMES, [1.0, 0.5, 0.0, 0.2, 0.0, 0.1, 1.0, 2.0, 0.0, 0.0]))
+    p = dict(zip(SMOOTH_NAMES, [1.0, 0.5, 0.0, 0.2, 0.0, 0.1, 0.0, 1.0, 2.0, 0.0, 0.0]))
     p.update(bad)
     with pytest.raises(InvalidParametersError, match=rule):
         FAMILY.check(np.array(list(p.values())))
@@ -127,7 +119,7 @@ def test_invalid_sets_are_refused_by_name(bad, rule):
 
 
 def test_compensator_runs_the_smooth_inverse_in_line():
-    values = dict(zip(SMOOTH_NAMES, [0.8, 0.4, 0.0, 0.3, 0.2, 0.1, 0.6, 3.0, 0.2, 1.0]))
+    values = dict(zip(SMOOTH_NAMES, [0.8, 0.4, 0.0, 0.3, 0.2, 0.1, 0.2, 0.6, 3.0, 0.2, 1.0]))
     model = InverseModel.from_mapping({'family': 'smooth', **values,
                                        'm_bl': 1.0, 'c_bl': -0.05, 'c_br': 0.05})
     comp = Compensator(model, v0=0.0)
@@ -143,28 +135,10 @@ def test_compensator_runs_the_smooth_inverse_in_line():
     np.testing.assert_allclose(out[1:], desired[1:], atol=1e-9)
 
 
-def _smooth_recording(seed: int):
-    """A pressure recording of a random smooth loop, backlash and lag; its true noise floor."""
-    rng = np.random.default_rng([8, seed])
-    p = random_params(rng)
-    p[N_PLAYS + 2] = 0.0
-    t = np.arange(3000) * 0.02
-    v = 2.0 * np.sin(2 * np.pi * t / 12.0) * (0.4 + 0.6 * np.exp(-t / 25.0))
-    v += 0.3 * np.sin(2 * np.pi * t / 2.7)
-    u = plain_play_sum(p, v)
-    span = np.ptp(u)
-    band = rng.uniform(0.0, 0.15) * span
-    y0 = first_order_sensor(t, backlash(u, 1.0, -0.5 * band, 0.5 * band), 0.3)
-    sigma = 0.005 * np.ptp(y0)
-    y = 40.0 * y0 + 3.0 + 40.0 * rng.normal(0.0, sigma, t.size)
-    floor = float(np.sqrt(t.size * (40.0 * sigma) ** 2 / (y @ y)) * 100.0)
-    return Recording(t, v, y, 'pressure', 'V', 'kPa', f'smooth #{seed}'), floor
-
-
 @pytest.mark.slow
 @pytest.mark.parametrize('seed', range(3))
 def test_identify_reaches_the_true_floor_on_smooth_loops(seed):
-    rec, floor = _smooth_recording(seed)
+    rec, floor = smooth_recording(seed)
     spec = domains_from_data(rec, family='smooth')
     ident = identify(rec, spec=spec, settings=IdentifySettings(workers=1))
     assert ident.family == 'smooth'
