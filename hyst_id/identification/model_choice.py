@@ -112,7 +112,8 @@ def choose_family(recording: Recording, families: Sequence[str] = AUTO_FAMILIES,
                   settings: IdentifySettings | None = None, fit_share: float = 0.7,
                   tie_ratio: float = 1.02,
                   progress: Callable[[str, str], None] | None = None,
-                  seed_progress: Callable | None = None) -> ModelChoice:
+                  seed_progress: Callable | None = None,
+                  on_generation: Callable | None = None) -> ModelChoice:
     """Identify each family on the first part, keep the one that predicts the rest best.
 
     Parameters
@@ -129,8 +130,8 @@ def choose_family(recording: Recording, families: Sequence[str] = AUTO_FAMILIES,
         A later family must beat the best earlier one by more than this factor.
     progress : callable, optional
         Called as ``progress(family, stage)`` with stage ``'train'`` or ``'final'``.
-    seed_progress : callable, optional
-        Passed to every :func:`identify` as its per-seed ``progress``.
+    seed_progress, on_generation : callable, optional
+        Passed to every :func:`identify` as its ``progress`` and ``on_generation``.
 
     Returns
     -------
@@ -164,7 +165,7 @@ def choose_family(recording: Recording, families: Sequence[str] = AUTO_FAMILIES,
         if progress:
             progress(fam, 'train')
         ident = identify(train, spec=domains_from_data(train, family=fam), settings=settings,
-                         progress=seed_progress)
+                         progress=seed_progress, on_generation=on_generation)
         tr, ho = holdout_error(ident, rec, train.n_samples)
         scores.append(FamilyScore(fam, tr, ho, ident))
     best = scores[0]
@@ -174,7 +175,7 @@ def choose_family(recording: Recording, families: Sequence[str] = AUTO_FAMILIES,
     if progress:
         progress(best.family, 'final')
     final = identify(rec, spec=domains_from_data(rec, family=best.family), settings=settings,
-                     progress=seed_progress)
+                     progress=seed_progress, on_generation=on_generation)
     return ModelChoice(best.family, tuple(scores), final, fit_share)
 
 

@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 
 from hyst_id.compensation import InverseModel
-from hyst_id.compensation.params_file import COMPENSATOR_NAMES
+from hyst_id.compensation.params_file import compensator_names
 from hyst_id.errors import InvalidParametersError
 from hyst_id.identification import Identification
 from hyst_id.identification.chains import chain_spec
@@ -46,7 +46,8 @@ def compensator_set(ident: Identification) -> tuple[dict | None, float, str]:
     check is kept as a guard: a set the compensator would refuse gives
     ``(None, nan, reason)`` and nothing is handed over.
     """
-    best = dict(ident.params, output_sign=float(getattr(ident, 'output_sign', 1.0)))
+    best = dict(ident.params, output_sign=float(getattr(ident, 'output_sign', 1.0)),
+                family=ident.family)
     try:
         InverseModel.from_mapping(best)
     except InvalidParametersError as exc:
@@ -69,7 +70,8 @@ def result_document(ident: Identification, n_samples: int, duration_s: float,
     return {
         'compensator_params': comp, 'compensator_er_percent': comp_er,
         'compensator_note': note,
-        'channel': ident.channel, 'params': ident.params, 'er_percent': ident.er_percent,
+        'channel': ident.channel, 'family': ident.family, 'params': ident.params,
+        'er_percent': ident.er_percent,
         'output_sign': float(getattr(ident, 'output_sign', 1.0)),
         'params_mean': ident.params_mean,
         'er_mean_params_percent': ident.er_mean_params_percent,
@@ -89,8 +91,12 @@ def recovered_document(values: dict, path: Any) -> dict:
     What the identifier republishes after a restart: the set of its last
     result, as both ``params`` and ``compensator_params``.
     """
-    params = {n: float(values[n]) for n in COMPENSATOR_NAMES + ('output_sign',)}
-    return {'channel': values['channel'], 'params': params, 'compensator_params': params,
+    family = str(values.get('family', 'tk'))
+    params: dict[str, Any] = {n: float(values[n])
+                              for n in compensator_names(family) + ('output_sign',)}
+    params['family'] = family
+    return {'channel': values['channel'], 'family': family, 'params': params,
+            'compensator_params': params,
             'output_sign': params['output_sign'], 'er_percent': values['er_percent'],
             'compensator_er_percent': values['er_percent'], 'compensator_note': '',
             'notes': [], 'source': f'recovered from {path}'}

@@ -29,6 +29,7 @@ from typing import Any
 from hyst_id.errors import HystIdError
 from hyst_id.identification import Identification, identify, IdentifySettings, SeedRun
 from hyst_id.identification.chains import ChainSpec
+from hyst_id.identification.model_choice import choose_family, ModelChoice
 from hyst_id.io.recording import Recording
 
 __all__ = ['BackgroundJob', 'DiagnosisJob', 'IdentificationJob', 'JobCancelled']
@@ -121,19 +122,32 @@ class IdentificationJob(BackgroundJob):
     waits (a cancel takes effect when they are done). :meth:`progress` is
     safe to call from another thread at any time; with ``workers == 1`` it
     also gives the running seed's GAASS generation.
+
+    With ``families`` (ids, e.g. ``('tk', 'smooth')``) H's family is chosen
+    on held-out data first (:func:`~hyst_id.identification.model_choice.choose_family`;
+    ``spec`` is then unused): the seeds run once per family and once more
+    for the final fit, and :attr:`choice` holds the comparison.
     """
 
     name = 'identify'
 
-    def __init__(self, rec: Recording, spec: ChainSpec, settings: IdentifySettings) -> None:
+    def __init__(self, rec: Recording, spec: ChainSpec | None, settings: IdentifySettings,
+                 families: tuple[str, ...] = ()) -> None:
         super().__init__()
         self.rec, self.spec, self.settings = rec, spec, settings
-        self.seeds = tuple(settings.seeds)
+        self.families = tuple(families)
+        self.choice: ModelChoice | None = None
+        self.seeds = tuple(settings.seeds) * ((len(self.families) + 1) if self.families else 1)
         self.runs: list[SeedRun] = []
         self.generation: dict[str, Any] = {}
         self.start()
 
     def work(self) -> Identification:
+        if self.families:
+            self.choice = choose_family(self.rec, self.families, settings=self.settings,
+                                        seed_progress=self._progress,
+                                        on_generation=self._generation)
+            return self.choice.identification
         return identify(self.rec, spec=self.spec, settings=self.settings,
                         progress=self._progress, on_generation=self._generation)
 

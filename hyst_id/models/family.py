@@ -141,6 +141,8 @@ class HysteresisFamily:
     names: tuple[str, ...] = ()
     #: Unit kind of each parameter (see :data:`UNIT_KINDS`).
     units: Mapping[str, str] = {}
+    #: One-phrase meaning of each parameter (node parameter descriptions, reports).
+    descriptions: Mapping[str, str] = {}
     #: Fixed search domains by name (a preset), or None.
     paper_domains: Mapping[str, tuple[float, float]] | None = None
 

@@ -253,6 +253,11 @@ class Smooth(HysteresisFamily):
              'tanh saturation')
     names = SMOOTH_NAMES
     units = UNITS
+    descriptions = {**{n: f'weight of play {k} (threshold r_max * {k} / {N_PLAYS - 1})'
+                       for k, n in enumerate(WEIGHT_NAMES)},
+                    'w_l': 'reversible slope on the raw command (past saturation)',
+                    'r_max': 'widest play threshold', 'v_s': 'saturation reach of the '
+                    'input map', 'v_c': 'centre of the input map', 'c_o': 'output offset'}
 
     def check(self, params: np.ndarray) -> np.ndarray:
         """Validate a set (finite; ``w_0 > 0``, ``w_k, w_l, r_max >= 0``, ``v_s > 0``)."""

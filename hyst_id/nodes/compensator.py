@@ -51,9 +51,10 @@ from std_msgs.msg import Float64, String
 from hyst_id.compensation import CommandLimits, InverseModel
 from hyst_id.compensation import Compensator as CoreCompensator
 from hyst_id.compensation.inverse import warm_up
-from hyst_id.compensation.params_file import COMPENSATOR_NAMES
+from hyst_id.compensation.params_file import ALL_MODEL_NAMES, compensator_names
 from hyst_id.errors import InvalidParametersError
 from hyst_id.io.recording import CHANNELS
+from hyst_id.models.registry import DEFAULT_FAMILY, FAMILIES, get_family
 from hyst_id.nodes.support import (
     COMMAND_QOS,
     DESIRED_TOPIC,
@@ -69,7 +70,7 @@ from hyst_id.nodes.support import (
 __all__ = ['ACTIVE_SET_QOS', 'Compensator', 'PARAMS', 'main']
 
 _NAN = math.nan
-_MODEL_KEYS = set(COMPENSATOR_NAMES) | {'output_sign'}
+_MODEL_KEYS = set(ALL_MODEL_NAMES) | {'output_sign', 'family'}
 _LIMIT_KEYS = {'min_command', 'max_command', 'max_rate_per_s'}
 #: ``~/active_set``: every generation, late joiners get the last 100.
 ACTIVE_SET_QOS = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE,
@@ -81,15 +82,23 @@ _DESCRIPTIONS = {
     'c_t': 'hysteresis top-line intercept', 'c_b': 'hysteresis bottom-line intercept',
     'm_bl': 'backlash slope (1 in the canonical gauge)', 'c_bl': 'backlash left crossing',
     'c_br': 'backlash right crossing',
+    # every other family's parameters (one module each, hyst_id.models.registry)
+    **{n: f'{f} family: {get_family(f).descriptions.get(n, n)}' for f in FAMILIES
+       for n in get_family(f).names if f != DEFAULT_FAMILY},
 }
 _UNITS = {'m_l': 'out/mA', 'm_r': 'out/mA', 'm_t': 'out/mA', 'm_b': 'out/mA', 'c_l': 'mA',
-          'c_r': 'mA', 'c_t': 'out', 'c_b': 'out', 'm_bl': '1', 'c_bl': 'out', 'c_br': 'out'}
+          'c_r': 'mA', 'c_t': 'out', 'c_b': 'out', 'm_bl': '1', 'c_bl': 'out', 'c_br': 'out',
+          **{n: u.replace('cmd', 'mA') for f in FAMILIES if f != DEFAULT_FAMILY
+             for n, u in get_family(f).units.items()}}
 
 PARAMS = [
     Param('channel', 'position', 'measured channel the model was identified on; '
           'identified-parameter messages of another channel are ignored', choices=CHANNELS),
-    *[Param(n, _NAN, _DESCRIPTIONS[n] + '; .nan = unset', unit=_UNITS[n])
-      for n in COMPENSATOR_NAMES],
+    Param('family', DEFAULT_FAMILY, "H's family of the set: 'tk' (the paper's loop) or "
+          "'smooth' (Prandtl-Ishlinskii); only that family's parameters are used",
+          choices=tuple(FAMILIES)),
+    *[Param(n, _NAN, _DESCRIPTIONS.get(n, n) + '; .nan = unset', unit=_UNITS.get(n, ''))
+      for n in ALL_MODEL_NAMES],
     Param('output_sign', 1.0, 'sign of the sensor gain (canonical calibration): -1 when the '
           'measurement falls as the actuator output rises', low=-1.0, high=1.0),
     Param('er_percent', _NAN, '%e_r (Eq. 7) of the identification; information only'),
@@ -118,13 +127,17 @@ def _limits(values: dict[str, Any]) -> CommandLimits:
 
 
 def _model_state(values: dict[str, Any]) -> tuple[str, InverseModel | None, list[str]]:
-    """Classify the model parameters: ('none'|'incomplete'|'valid', model, unset names)."""
-    unset = [n for n in COMPENSATOR_NAMES if math.isnan(values[n])]
-    if len(unset) == len(COMPENSATOR_NAMES):
+    """Classify the model parameters: ('none'|'incomplete'|'valid', model, unset names).
+
+    Only the parameters of ``values['family']`` count; the other families' are ignored.
+    """
+    names = compensator_names(values['family'])
+    unset = [n for n in names if math.isnan(values[n])]
+    if len(unset) == len(names):
         return 'none', None, unset
     if unset:
         return 'incomplete', None, unset
-    mapping = {n: values[n] for n in COMPENSATOR_NAMES + ('output_sign',)}
+    mapping = {n: values[n] for n in names + ('output_sign', 'family')}
     return 'valid', InverseModel.from_mapping(mapping), []
 
 
@@ -174,7 +187,8 @@ class Compensator(HystNode):
         if values['output_sign'] not in (1.0, -1.0):
             return f'output_sign must be 1.0 or -1.0; got {values["output_sign"]!r}'
         if changed & _MODEL_KEYS:
-            inf = [n for n in COMPENSATOR_NAMES if math.isinf(values[n])]
+            names = compensator_names(values['family'])
+            inf = [n for n in names if math.isinf(values[n])]
             if inf:
                 return f'{", ".join(inf)} must be finite (or .nan for unset)'
             try:
@@ -183,8 +197,9 @@ class Compensator(HystNode):
                 return f'{exc}; keeping the last good set'
             if kind == 'incomplete' and getattr(self, '_comp', None) is not None \
                     and self._comp.model is not None:
-                return (f'incomplete set (unset: {", ".join(unset)}): give all 11 '
-                        'parameters together; keeping the last good set')
+                return (f'incomplete {values["family"]} set (unset: {", ".join(unset)}): '
+                        f'give all {len(names)} parameters together; keeping the last good '
+                        'set')
         return None
 
     def apply_params(self, values: dict[str, Any], changed: set[str]) -> None:
@@ -229,7 +244,8 @@ class Compensator(HystNode):
         doc = {'generation': self._generation, 'first_sample': self._n, 'source': source,
                'channel': values['channel'],
                'model': None if model is None else {
-                   n: values[n] for n in COMPENSATOR_NAMES + ('output_sign',)},
+                   n: values[n] for n in compensator_names(values['family'])
+                   + ('output_sign', 'family')},
                'min_command': lim.min_command, 'max_command': lim.max_command,
                'max_rate_per_s': None if math.isinf(lim.max_rate_per_s)
                else lim.max_rate_per_s}
@@ -243,7 +259,9 @@ class Compensator(HystNode):
         head = f'channel {values["channel"]}' + ('' if math.isnan(er) else f', %e_r {er:.3g}')
         if values.get('output_sign', 1.0) < 0:
             head += ', output_sign -1'
-        return head + ': ' + ', '.join(f'{n}={values[n]:.6g}' for n in COMPENSATOR_NAMES)
+        names = compensator_names(values['family'])
+        return (head + f', family {values["family"]}: '
+                + ', '.join(f'{n}={values[n]:.6g}' for n in names))
 
     # ------------------------------------------------------------- callbacks
     def _on_desired(self, msg: Float64) -> None:
@@ -268,7 +286,11 @@ class Compensator(HystNode):
             doc = json.loads(msg.data)
             params = doc.get('compensator_params') or doc.get('params', doc)
             channel = str(doc.get('channel', params.get('channel', '')))
-            values = {n: float(params[n]) for n in COMPENSATOR_NAMES}
+            family = str(params.get('family', doc.get('family', DEFAULT_FAMILY)))
+            if family not in FAMILIES:
+                raise ValueError(f'unknown family {family!r}')
+            values: dict[str, Any] = {n: float(params[n]) for n in compensator_names(family)}
+            values['family'] = family
             values['output_sign'] = float(doc.get('output_sign', params.get('output_sign', 1.0)))
             er = float(doc.get('compensator_er_percent', doc.get('er_percent', _NAN)))
         except (ValueError, TypeError, KeyError, AttributeError) as exc:

@@ -51,6 +51,7 @@ from hyst_id.compensation.params_file import (
 from hyst_id.errors import ConfigError, HystIdError
 from hyst_id.identification import Identification, IdentifySettings
 from hyst_id.identification.config import make_settings, make_spec
+from hyst_id.identification.model_choice import AUTO_FAMILIES
 from hyst_id.io.recording import CHANNELS, Recording, validate_recording
 from hyst_id.io.topics import get_field, parse_field_path, TopicConfig
 from hyst_id.live import (
@@ -119,6 +120,9 @@ PARAMS = [
           low=0.0, high=1000.0, unit='%'),
     Param('domains', 'auto', "search domains: 'auto' (from the data), 'paper', or a YAML "
           'file of name: [low, high]'),
+    Param('model', 'tk', "H's family: 'tk' (the paper's piecewise-linear loop), 'smooth' "
+          "(Prandtl-Ishlinskii, curved branches) or 'auto' (fit both on the first 70 % of the "
+          'run, keep the lower held-out error)', choices=('tk', 'smooth', 'auto')),
     Param('params_out', '', 'compensator params file written after each identification '
           "('' = $ROS_HOME/hyst_id/compensator.yaml)", read_only=True),
     Param('recover_on_start', True, 'republish the parameter set found in params_out at '
@@ -221,6 +225,10 @@ class Identifier(HystNode):
         if 'domains' in changed and dom not in ('auto', 'paper') \
                 and not Path(dom).expanduser().is_file():
             return f"domains must be 'auto', 'paper' or an existing YAML file; got {dom!r}"
+        if {'domains', 'model'} & changed and dom != 'auto' and values['model'] == 'auto':
+            return "model 'auto' derives each family's domains from the data: domains must be auto"
+        if {'domains', 'model'} & changed and dom == 'paper' and values['model'] != 'tk':
+            return f"the 'paper' domains are for model 'tk', not {values['model']!r}"
         return None
 
     def apply_params(self, values: dict[str, Any], changed: set[str]) -> None:
@@ -278,8 +286,12 @@ class Identifier(HystNode):
             return False, self._busy()
         try:
             rec = validate_recording(self._recording())
-            spec = make_spec(rec, self.p('domains'))
-            self.job = IdentificationJob(rec, spec, self.settings())
+            model = self.p('model')
+            if model == 'auto':
+                self.job = IdentificationJob(rec, None, self.settings(), families=AUTO_FAMILIES)
+            else:
+                spec = make_spec(rec, self.p('domains'), family=model)
+                self.job = IdentificationJob(rec, spec, self.settings())
         except HystIdError as exc:
             self._fail(f'cannot identify ({why}): {exc}; {self._kept()}')
             return False, str(exc)
@@ -398,6 +410,11 @@ class Identifier(HystNode):
             self._fail(f'identified {ident.channel} (%e_r {ident.er_percent:.3f}) but '
                        f'{doc["compensator_note"]}; {self._kept()}')
             return
+        if job.choice is not None:
+            doc['model_choice'] = job.choice.to_dict()
+            self.get_logger().info('H family chosen on held-out data: ' + ', '.join(
+                f'{c.family} {c.holdout_er_percent:.4f} %' for c in job.choice.scores)
+                + f' -> {job.choice.chosen}')
         self.last_document = doc
         self.last_error = ''
         self._result_pub.publish(String(data=json.dumps(doc)))

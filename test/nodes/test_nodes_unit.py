@@ -136,6 +136,9 @@ def test_defaults_match_the_params_files():
     (Excitation, {'hold_s': -1.0}, 'hold_s'),
     (Identifier, {'domains': '/no/such/domains.yaml'}, 'domains'),
     (Identifier, {'pop_size': 1}, 'pop_size'),
+    (Identifier, {'model': 'preisach'}, 'one of'),
+    (Identifier, {'model': 'smooth', 'domains': 'paper'}, 'paper'),
+    (Identifier, {'model': 'auto', 'domains': 'paper'}, 'domains must be auto'),
 ])
 def test_bad_parameters_are_rejected_with_a_reason(ctx, cls, values, needle):
     node = _make(ctx, cls)
@@ -224,6 +227,44 @@ def test_compensator_follows_the_latched_identified_params(ctx):
                                         'compensator_params': PAPER, 'er_percent': 1.5})))
     assert _spin_until(ctx, [comp, talker], lambda: comp.model is not None)
     assert comp.p('m_l') == PAPER['m_l'] and comp.p('er_percent') == 1.5
+
+
+SMOOTH = {'family': 'smooth', 'w_0': 0.8, 'w_1': 0.4, 'w_2': 0.0, 'w_3': 0.3, 'w_4': 0.2,
+          'w_5': 0.1, 'w_l': 0.05, 'r_max': 0.6, 'v_s': 3.0, 'v_c': 9.0, 'c_o': 9.0,
+          'm_bl': 1.0, 'c_bl': -0.05, 'c_br': 0.05}
+
+
+def test_compensator_swaps_between_families_atomically(ctx):
+    """Either family runs in-line, with the same atomic swaps, limits and rejections."""
+    comp = _make(ctx, Compensator)
+    assert _set(comp, **PAPER).successful
+    tk_model = comp.model
+    assert _set(comp, **SMOOTH).successful
+    assert comp.model is not tk_model and comp.model.family == 'smooth'
+    smooth_model = comp.model
+    bad = _set(comp, **{**SMOOTH, 'w_0': 0.0})
+    assert not bad.successful and 'w_0' in bad.reason and 'keeping the last good' in bad.reason
+    assert comp.model is smooth_model
+    assert not _set(comp, w_l=math.inf).successful and comp.model is smooth_model
+    missing = _set(comp, family='tk', **{n: math.nan for n in ('m_l', 'm_r')})
+    assert not missing.successful and 'incomplete tk set' in missing.reason
+    assert comp.model is smooth_model
+    assert _set(comp, max_command=9.2).successful
+    assert comp.step(15.0) <= 9.2
+    assert not _set(comp, family='preisach').successful
+    assert _set(comp, family='tk', **PAPER).successful and comp.model.family == 'tk'
+
+
+def test_compensator_follows_identified_smooth_params(ctx):
+    comp = _make(ctx, Compensator)
+    talker = _make(ctx, Node, 'talker')
+    pub = talker.create_publisher(String, '/hyst_id/identified_params', LATCHED_QOS)
+    params = {k: v for k, v in SMOOTH.items() if k != 'family'}
+    pub.publish(String(data=json.dumps({'channel': 'position', 'family': 'smooth',
+                                        'compensator_params': params, 'er_percent': 0.7})))
+    assert _spin_until(ctx, [comp, talker], lambda: comp.model is not None)
+    assert comp.p('family') == 'smooth' and comp.p('w_3') == SMOOTH['w_3']
+    assert comp.model.family == 'smooth'
 
 
 def test_compensator_inverts_the_simulated_actuator(ctx):
@@ -332,6 +373,26 @@ def test_identifier_identify_now_publishes_writes_and_matches_identify(ctx, tmp_
     assert read_compensator_params(out)['m_l'] == doc['compensator_params']['m_l']
     ref = identify(rec, settings=ident.settings(), spec=chain_spec('position'))
     assert ref.params == doc['params']
+
+
+def test_identifier_model_auto_chooses_and_reports_the_family(ctx, tmp_path):
+    out = tmp_path / 'comp.yaml'
+    ident = _make(ctx, Identifier, parameter_overrides=[
+        Parameter('seeds', value=1), Parameter('generations', value=40),
+        Parameter('model', value='auto'), Parameter('params_out', value=str(out)),
+        Parameter('end_of_run_timeout_s', value=0.0)])
+    got = []
+    listener = _make(ctx, Node, 'listener')
+    listener.create_subscription(String, '/hyst_id/identified_params',
+                                 lambda m: got.append(json.loads(m.data)), LATCHED_QOS)
+    _feed(ident)
+    assert _set(ident, identify_now=True).successful
+    assert _spin_until(ctx, [ident, listener], lambda: bool(got), timeout=300.0)
+    doc = got[-1]
+    choice = doc['model_choice']
+    assert {f['family'] for f in choice['families']} == {'tk', 'smooth'}
+    assert doc['family'] == choice['chosen']
+    assert read_compensator_params(out)['family'] == choice['chosen']
 
 
 def test_identifier_refuses_with_a_reason(ctx):
