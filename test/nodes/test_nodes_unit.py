@@ -353,20 +353,24 @@ def _feed(ident: Identifier, n: int = 400, dt_ns: int = 50_000_000) -> Recording
     return Recording(t, v, y, 'position')
 
 
-def test_identifier_identify_now_publishes_writes_and_matches_identify(ctx, tmp_path):
-    out = tmp_path / 'comp.yaml'
+def _identify_now(ctx, out, timeout: float, **params):
+    """An identifier fed a simulated run, triggered; its node, the run and the document."""
     ident = _make(ctx, Identifier, parameter_overrides=[
-        Parameter('seeds', value=2), Parameter('generations', value=40),
-        Parameter('domains', value='paper'), Parameter('params_out', value=str(out)),
-        Parameter('end_of_run_timeout_s', value=0.0)])
+        Parameter(k, value=v) for k, v in params.items()] + [
+        Parameter('params_out', value=str(out)), Parameter('end_of_run_timeout_s', value=0.0)])
     got = []
     listener = _make(ctx, Node, 'listener')
     listener.create_subscription(String, '/hyst_id/identified_params',
                                  lambda m: got.append(json.loads(m.data)), LATCHED_QOS)
     rec = _feed(ident)
     assert _set(ident, identify_now=True).successful
-    assert _spin_until(ctx, [ident, listener], lambda: bool(got), timeout=120.0)
-    doc = got[-1]
+    assert _spin_until(ctx, [ident, listener], lambda: bool(got), timeout=timeout)
+    return ident, rec, got[-1]
+
+
+def test_identifier_identify_now_publishes_writes_and_matches_identify(ctx, tmp_path):
+    out = tmp_path / 'comp.yaml'
+    ident, rec, doc = _identify_now(ctx, out, 120.0, seeds=2, generations=40, domains='paper')
     assert doc['channel'] == 'position' and doc['n_samples'] == rec.n_samples
     assert doc['er_percent'] < 1.0
     assert ident.p('identify_now') is False
@@ -377,18 +381,7 @@ def test_identifier_identify_now_publishes_writes_and_matches_identify(ctx, tmp_
 
 def test_identifier_model_auto_chooses_and_reports_the_family(ctx, tmp_path):
     out = tmp_path / 'comp.yaml'
-    ident = _make(ctx, Identifier, parameter_overrides=[
-        Parameter('seeds', value=1), Parameter('generations', value=40),
-        Parameter('model', value='auto'), Parameter('params_out', value=str(out)),
-        Parameter('end_of_run_timeout_s', value=0.0)])
-    got = []
-    listener = _make(ctx, Node, 'listener')
-    listener.create_subscription(String, '/hyst_id/identified_params',
-                                 lambda m: got.append(json.loads(m.data)), LATCHED_QOS)
-    _feed(ident)
-    assert _set(ident, identify_now=True).successful
-    assert _spin_until(ctx, [ident, listener], lambda: bool(got), timeout=300.0)
-    doc = got[-1]
+    _, _, doc = _identify_now(ctx, out, 300.0, seeds=1, generations=40, model='auto')
     choice = doc['model_choice']
     assert {f['family'] for f in choice['families']} == {'tk', 'smooth'}
     assert doc['family'] == choice['chosen']
