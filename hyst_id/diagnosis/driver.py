@@ -59,6 +59,7 @@ from hyst_id.diagnosis.select import (
 )
 from hyst_id.errors import ConfigError, RecordingError
 from hyst_id.identification.chains import chain_spec, ChainSpec
+from hyst_id.identification.domains import domains_from_data
 from hyst_id.io.recording import Recording, roundoff_probe, validate_recording
 from hyst_id.signals.noise import floor_percent
 from hyst_id.signals.reversals import period_s
@@ -84,10 +85,13 @@ def _info(fit: FitResult, ctx: Context, command: np.ndarray) -> dict:
     lo, hi = fit.span
     ends = to_meas(np.array([lo, hi]))
     a = ctx.command_scale[0]
+    if model.spec.family.id == 'tk':
+        pos_per_cmd = float(x_chain[1] * x_chain[8] / a)      # right line times backlash
+    else:                                                     # mean slope over the travel
+        pos_per_cmd = float(np.ptp(fit.travel_raw) / max(float(np.ptp(command)), 1e-300))
     return {'coef': fit.coef, 'labels': fit.labels, 'span': fit.span, 'x_chain': x_chain,
             'to_meas': to_meas, 'meas_per_pos': float((ends[1] - ends[0]) / (hi - lo)),
-            'pos_per_cmd': float(x_chain[1] * x_chain[8] / a), 'command': command,
-            'travel_raw': fit.travel_raw}
+            'pos_per_cmd': pos_per_cmd, 'command': command, 'travel_raw': fit.travel_raw}
 
 
 def located_where(loc: Localization, own: dict) -> dict:
@@ -116,8 +120,10 @@ def finding_from(comp: Comparison, before: FitResult, mech: Mechanism, loc: Loca
                  ctx: Context, command: np.ndarray) -> Finding:
     """Turn an accepted comparison into a :class:`Finding` with words and units."""
     fit = comp.fit
-    theta = fit.model.theta(fit.p, mech.id)
-    values = mech.describe(theta, fit.coef, _info(fit, ctx, command), ctx)
+    theta = fit.model.theta(fit.p, mech.id) if mech.id in fit.model.slices else np.zeros(0)
+    info = _info(fit, ctx, command)
+    info.update(er_before=before.er_holdout_percent, er_after=fit.er_holdout_percent)
+    values = mech.describe(theta, fit.coef, info, ctx)
     where = located_where(loc, comp.where)
     return Finding(mechanism=mech.id, title=mech.title, placement=mech.placement,
                    explanation=mech.explain(values, where, ctx), where=where, params=values,
@@ -202,9 +208,11 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
         if round_no > 0 and current.er_holdout_percent <= 1.2 * floor_h:
             break   # what structure is left is within the noise on held-out data
         done = set(current.ids)
+        family = current.model.spec.family.id
         comps = []
         for m in mechs:
-            if m.id in done:
+            if m.id in done or (m.families is not None and family not in m.families) \
+                    or getattr(m, 'swap_family', '') == family:
                 continue
             say(f'round {round_no + 1}: testing {m.id}')
             comps.append(_try(m, current, data, ctx, settings, loc, chain_starts))
@@ -252,15 +260,49 @@ def _try(m: Mechanism, current: FitResult, data: Data, ctx: Context,
          settings: DiagnoseSettings, loc: Localization,
          chain_starts: list[np.ndarray]) -> Comparison:
     prev = current.model
-    model = ComposedModel(ctx.channel, list(prev.mechanisms) + [m], ctx,
-                          prev.bounds[:prev.n_chain])
     thetas = {pm.id: prev.theta(current.p, pm.id) for pm in prev.mechanisms}
-    p_prev = model.pack(current.p[:prev.n_chain], thetas)
-    fit = fit_model(model, data, p_prev, m, budget=settings.fit_budget,
-                    chain_starts=chain_starts)
+    if getattr(m, 'swap_family', ''):
+        fit = _swap_family(m, current, data, ctx, settings, thetas)
+    else:
+        model = ComposedModel(ctx.channel, list(prev.mechanisms) + [m], ctx,
+                              prev.bounds[:prev.n_chain], family=prev.spec.family.id,
+                              swapped_by=prev.swapped_by)
+        p_prev = model.pack(current.p[:prev.n_chain], thetas)
+        # the data-built starts are the baseline family's chains
+        fit = fit_model(model, data, p_prev, m, budget=settings.fit_budget,
+                        chain_starts=[c for c in chain_starts if c.size == prev.n_chain])
     comp = compare(current, fit, data, m.id, settings.criteria)
     comp.evidence, comp.where = m.evidence(loc)
-    reason = m.implausible(model.theta(fit.p, m.id), fit.coef, fit.span, data.noise_std)
+    model = fit.model
+    theta = model.theta(fit.p, m.id) if m.id in model.slices else np.zeros(0)
+    reason = m.implausible(theta, fit.coef, fit.span, data.noise_std)
     if reason and comp.accepted:
         comp.accepted, comp.status = False, f'rejected: {reason}'
     return comp
+
+
+def _swap_family(m: Mechanism, current: FitResult, data: Data, ctx: Context,
+                 settings: DiagnoseSettings, thetas: dict) -> FitResult:
+    """The chain refitted with H from ``m.swap_family`` (the blocks that work with it kept).
+
+    H's family changes the chain's parameters, so there is nothing to
+    warm-start from: the new chain gets its own baseline fit (GAASS seeds and
+    data-built starts on the training part, each polished with the kept blocks).
+    """
+    prev, fam, n = current.model, m.swap_family, data.n_train
+    rec_train = Recording(data.t_s[:n], data.v[:n], data.y[:n], ctx.channel)
+    spec = domains_from_data(rec_train, family=fam)
+    keep = [pm for pm in prev.mechanisms if pm.families is None or fam in pm.families]
+    model = ComposedModel(ctx.channel, keep, ctx, spec.bounds, family=fam, swapped_by=m.id)
+    x_ga, starts = baseline_starts(rec_train, spec, settings)
+    best = None
+    for x0 in [x_ga] + starts:
+        p0 = model.pack(x0, thetas)
+        if not model.feasible(p0):
+            continue
+        got = polish(model, data, p0, max_nfev=2 * settings.fit_budget)
+        if best is None or got[1] < best[1]:
+            best = got
+    if best is None:
+        return current
+    return evaluate(model, data, best[0], best[2])

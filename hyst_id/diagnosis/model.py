@@ -72,11 +72,15 @@ class ComposedModel:
         ``(n_chain, 2)`` bounds of the chain's parameters.
     family : str, optional
         H's family (default the paper's ``tk``).
+    swapped_by : str, optional
+        Id of the mechanism that swapped H's family in (listed first in :attr:`ids`).
     """
 
     def __init__(self, channel: str, mechanisms: Sequence[Mechanism], ctx: Context,
-                 chain_bounds: np.ndarray, family: str | None = None) -> None:
+                 chain_bounds: np.ndarray, family: str | None = None,
+                 swapped_by: str = '') -> None:
         self.channel = channel
+        self.swapped_by = swapped_by
         self.ctx = ctx
         self.mechanisms = tuple(sorted(mechanisms, key=lambda m: STAGES.index(m.stage)))
         self.spec = chain_spec(channel, family=family)
@@ -95,8 +99,9 @@ class ComposedModel:
 
     @property
     def ids(self) -> tuple[str, ...]:
-        """Mechanism ids in signal order."""
-        return tuple(m.id for m in self.mechanisms)
+        """Mechanism ids in signal order (a family swap first)."""
+        return ((self.swapped_by,) if self.swapped_by else ()) + tuple(
+            m.id for m in self.mechanisms)
 
     @property
     def n_linear(self) -> int:

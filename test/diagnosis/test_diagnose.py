@@ -27,6 +27,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from smooth_reference import smooth_recording
 
 from hyst_id.cli import main
 from hyst_id.diagnosis import diagnose, DiagnoseSettings
@@ -105,7 +106,8 @@ def test_dead_time_is_named_with_its_value(delay_diagnosis):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize('mech', [m for m in MECHANISM_IDS if m != 'dead_time'])
+@pytest.mark.parametrize('mech', [m for m in MECHANISM_IDS
+                                  if m not in ('dead_time', 'loop_shape')])
 def test_each_mechanism_is_named(mech):
     d = diagnose(synthetic(mech, seed=5), settings=FAST)
     assert d.verdict == mech, d.report()
@@ -118,6 +120,19 @@ def test_each_mechanism_is_named(mech):
         check_end_stop(d)
         return
     assert f.er_holdout_after_percent < 0.7 * f.er_holdout_before_percent
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize('seed', range(2))
+def test_curved_branches_are_named_loop_shape(seed):
+    """A smooth (Prandtl-Ishlinskii) loop is a loop shape, not a block after the paper's loop."""
+    rec, floor = smooth_recording(seed)
+    d = diagnose(rec, settings=FAST)
+    assert d.verdict == 'loop_shape', d.report()
+    f = d.findings[0]
+    assert f.params['er_holdout_smooth'].value == pytest.approx(f.er_holdout_after_percent)
+    assert f.er_holdout_after_percent < 0.7 * f.er_holdout_before_percent
+    assert 'curved' in f.explanation and '--model smooth' in f.explanation
 
 
 def check_end_stop(d) -> None:
