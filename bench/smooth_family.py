@@ -17,9 +17,9 @@
 Four tables (docs/model.md, "The smooth family"):
 
 1. **Simulated smooth loops.** Prandtl-Ishlinskii loops (the plain reference
-   ``test/smooth_reference.py``) and Bouc-Wen loops (a plain Euler
-   integration here, 20 sub-steps a sample; a shape the smooth family can
-   only approximate), each behind ``reference_sim``'s backlash and
+   ``test/smooth_reference.py``) and Bouc-Wen loops (the piezo form
+   ``u = v - kappa z``, a plain Euler integration here, 20 sub-steps a sample;
+   a shape the smooth family can only approximate), each behind ``reference_sim``'s backlash and
    first-order sensor, 0.5 % noise: ``identify`` with the smooth family,
    best %e_r / the *true* noise floor.
 2. **Real loops, predicting what the fit did not see.** The shared B(H)
@@ -66,17 +66,22 @@ SETTLE = 250
 
 
 def bouc_wen(v: np.ndarray, a: float, beta: float, gamma: float, n: float,
-             alpha: float, substeps: int = 20) -> np.ndarray:
-    """Bouc-Wen loop ``u = alpha v + (1 - alpha) z``, ``dz = a dv - beta |dv| |z|^(n-1) z
-    - gamma dv |z|^n``, explicit Euler with ``substeps`` steps per sample, ``z(0) = 0``."""
+             kappa: float, substeps: int = 20) -> np.ndarray:
+    """Bouc-Wen actuator loop ``u = v - kappa z``, ``dz = a dv - beta |dv| |z|^(n-1) z
+    - gamma dv |z|^n``, explicit Euler with ``substeps`` steps per sample, ``z(0) = 0``.
+
+    The piezo form (the Bouc-Wen variable *subtracted*, Low and Guo): the output
+    lags the command and the loop runs counter-clockwise; ``u = v + kappa z``
+    would be the clockwise force-displacement loop of structural mechanics.
+    """
     z, out = 0.0, np.empty(v.size)
-    out[0] = alpha * v[0]
+    out[0] = v[0]
     for j in range(1, v.size):
         dv = (v[j] - v[j - 1]) / substeps
         for _ in range(substeps):
             az = abs(z)
             z += a * dv - beta * abs(dv) * az ** (n - 1.0) * z - gamma * dv * az ** n
-        out[j] = alpha * v[j] + (1.0 - alpha) * z
+        out[j] = v[j] - kappa * z
     return out
 
 
@@ -89,7 +94,9 @@ def _bouc_wen_recording(seed: int):
     v += 0.15 * amp * np.sin(2 * np.pi * t / 2.7)
     n = rng.choice([1.0, 1.5, 2.0])
     beta = rng.uniform(0.5, 2.0) / amp ** n
-    u = bouc_wen(v, 1.0, beta, rng.uniform(-0.5, 0.9) * beta, n, rng.uniform(0.05, 0.5))
+    gamma = rng.uniform(-0.5, 0.9) * beta
+    steepest = 2.0 * beta / (beta + gamma) if gamma < beta else 1.0     # max dz/dv
+    u = bouc_wen(v, 1.0, beta, gamma, n, rng.uniform(0.2, 0.8) / steepest)
     band = rng.uniform(0.0, 0.1) * np.ptp(u)
     y0 = first_order_sensor(t, backlash(u, 1.0, -0.5 * band, 0.5 * band), 0.3)
     sigma = 0.005 * np.ptp(y0)
