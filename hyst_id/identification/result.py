@@ -72,6 +72,15 @@ class IdentifySettings:
         sensor hold convention from the data
         (:func:`hyst_id.identification.driver.rank_conventions`; a seed's
         odd restarts try the runner-up); ``given``: keep the spec's.
+    global_evals : int
+        With refinement on, when the seeds end above ``global_factor`` times
+        the estimated noise floor, one run of scipy's differential evolution
+        with this many evaluations (a large population over the whole box,
+        under the best run's conventions), refined, joins the runs as seed
+        ``-1`` when it does better (:func:`hyst_id.identification.driver.global_phase`).
+        0: off.
+    global_factor : float
+        The floor multiple above which the global phase runs.
     """
 
     pop_size: int = 10
@@ -89,6 +98,8 @@ class IdentifySettings:
     er_bound_percent: float | None = None
     data_starts: bool = True
     conventions: str = 'auto'
+    global_evals: int = 200000
+    global_factor: float = 1.1
 
 
 @dataclass
