@@ -67,8 +67,10 @@ SETTLE = 250
 
 def bouc_wen(v: np.ndarray, a: float, beta: float, gamma: float, n: float,
              kappa: float, substeps: int = 20) -> np.ndarray:
-    """Bouc-Wen actuator loop ``u = v - kappa z``, ``dz = a dv - beta |dv| |z|^(n-1) z
-    - gamma dv |z|^n``, explicit Euler with ``substeps`` steps per sample, ``z(0) = 0``.
+    """Bouc-Wen actuator loop ``u = v - kappa z``, explicit Euler.
+
+    ``dz = a dv - beta |dv| |z|^(n-1) z - gamma dv |z|^n`` with ``substeps``
+    steps per sample and ``z(0) = 0``.
 
     The piezo form (the Bouc-Wen variable *subtracted*, Low and Guo): the output
     lags the command and the loop runs counter-clockwise; ``u = v + kappa z``

@@ -21,6 +21,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
+from hyst_id.compensation.params_file import compensator_names
 from hyst_id.errors import RecordingError
 from hyst_id.identification import IdentifySettings
 from hyst_id.identification.chains import chain_spec
@@ -81,12 +82,24 @@ def test_gaps_and_duplicates_are_reported():
 
 
 def test_compensator_set_is_the_best_run_with_a_guard():
-    ident = SimpleNamespace(params=dict(PAPER), er_percent=0.5, output_sign=-1.0)
+    ident = SimpleNamespace(params=dict(PAPER), er_percent=0.5, output_sign=-1.0, family='tk')
     comp, er, note = compensator_set(ident)
-    assert comp == {**PAPER, 'output_sign': -1.0} and er == 0.5 and note == ''
+    assert comp == {**PAPER, 'output_sign': -1.0, 'family': 'tk'} and er == 0.5 and note == ''
     ident.params['m_t'] = 2.0                        # cannot come out of identify
     comp, er, note = compensator_set(ident)
     assert comp is None and np.isnan(er) and 'not a valid compensator model' in note
+
+
+def test_compensator_set_carries_the_smooth_family():
+    names = compensator_names('smooth')
+    values = dict(zip(names, [0.5, 0.3, 0.0, 0.2, 0.0, 0.1, 0.05, 1.0, 2.0, 0.0, 0.0,
+                              1.0, -0.1, 0.1]))
+    ident = SimpleNamespace(params=values, er_percent=0.4, output_sign=1.0, family='smooth')
+    comp, er, note = compensator_set(ident)
+    assert comp == {**values, 'output_sign': 1.0, 'family': 'smooth'} and note == ''
+    ident.params['w_0'] = -1.0                       # a negative weight: not invertible
+    comp, er, note = compensator_set(ident)
+    assert comp is None and 'not a valid compensator model' in note
 
 
 def test_identification_job_cancels_between_seeds():
@@ -154,7 +167,7 @@ def test_diagnosis_statuses_one_per_finding():
 def test_recovered_document_carries_the_set():
     values = {'channel': 'position', **PAPER, 'output_sign': 1.0, 'er_percent': 0.2}
     doc = recovered_document(values, '/x/compensator.yaml')
-    assert doc['compensator_params'] == {**PAPER, 'output_sign': 1.0}
+    assert doc['compensator_params'] == {**PAPER, 'output_sign': 1.0, 'family': 'tk'}
     assert doc['source'] == 'recovered from /x/compensator.yaml' and doc['er_percent'] == 0.2
 
 
