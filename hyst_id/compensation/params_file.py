@@ -15,9 +15,10 @@
 """ROS 2 params files holding an identified compensator parameter set (any H family).
 
 :func:`write_compensator_params` writes what ``--ros-args --params-file``
-accepts for the compensator node::
+accepts for the compensator node, in any namespace (``/**``, so that
+``-r __ns:=/valve1`` keeps the set)::
 
-    compensator:
+    /**:
       ros__parameters:
         channel: position
         family: tk
@@ -126,7 +127,7 @@ def compensator_values(identification_or_dict: Any) -> dict[str, Any]:
 
 
 def write_compensator_params(identification_or_dict: Any, path: str | Path,
-                             node_name: str = 'compensator') -> Path:
+                             node_name: str = '/**') -> Path:
     """Write a ROS 2 params file for the compensator node.
 
     Parameters
@@ -136,7 +137,8 @@ def write_compensator_params(identification_or_dict: Any, path: str | Path,
     path : str or pathlib.Path
         File to write (parent directories are created).
     node_name : str
-        Node name the section is keyed by (``/**`` for any node).
+        Node name the section is keyed by: ``/**`` (default) for any node in
+        any namespace, ``/**/compensator`` for nodes of that name only.
 
     Returns
     -------

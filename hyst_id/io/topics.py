@@ -31,7 +31,8 @@ from hyst_id.errors import ConfigError
 from hyst_id.io.params_file import read_yaml
 from hyst_id.io.recording import CHANNELS
 
-__all__ = ['TopicConfig', 'get_field', 'load_topic_config', 'parse_field_path']
+__all__ = ['TOPIC_FILE_KEYS', 'TopicConfig', 'get_field', 'load_topic_config',
+           'parse_field_path']
 
 #: Per channel: topic, message type, field path, unit.
 _COMMAND_DEFAULTS = ('/hyst_id/command', 'std_msgs/msg/Float64', 'data', 'mA')
@@ -43,6 +44,8 @@ _CHANNEL_DEFAULTS = {
 _SUFFIXES = ('topic', 'type', 'field', 'unit')
 _KEYS = frozenset([f'command_{s}' for s in _SUFFIXES] + ['stamp_source']
                   + [f'{ch}_{s}' for ch in CHANNELS for s in _SUFFIXES])
+#: Every key ``params/topics.yaml`` may hold (shared by all nodes through ``/**``).
+TOPIC_FILE_KEYS = _KEYS
 _FIELD_RE = re.compile(r'[A-Za-z_]\w*(\[\d+\])*(\.[A-Za-z_]\w*(\[\d+\])*)*')
 
 
@@ -76,7 +79,9 @@ class TopicConfig:
     Attributes
     ----------
     command_topic, measurement_topic : str
-        Topic names.
+        Topic names, fully qualified: a relative name (``hyst_id/command``,
+        as the nodes' params files give them) is taken in the root
+        namespace, ``/hyst_id/command``.
     command_field, measurement_field : str
         Field paths in the messages (``data``, ``position[0]``, ...).
     command_type, measurement_type : str
@@ -107,6 +112,11 @@ class TopicConfig:
         for name in ('command_topic', 'measurement_topic', 'command_type', 'measurement_type'):
             if not getattr(self, name).strip():
                 raise ConfigError(f'{name} is empty')
+        for name in ('command_topic', 'measurement_topic'):
+            # A bag holds fully qualified names; a relative name (as the nodes'
+            # params files give them) means the root namespace here.
+            if not getattr(self, name).startswith('/'):
+                object.__setattr__(self, name, '/' + getattr(self, name))
         if self.command_topic == self.measurement_topic:
             raise ConfigError(f'command and measurement share the topic {self.command_topic}')
         parse_field_path(self.command_field)

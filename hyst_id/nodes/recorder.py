@@ -105,7 +105,8 @@ class Recorder(HystNode):
         topics = [t for t in self.p('topics') if t]
         if not topics:
             raise ConfigError('recorder: no topics to record')
-        self._wanted = list(dict.fromkeys(topics))
+        # relative names take the node's namespace; remaps apply
+        self._wanted = list(dict.fromkeys(self.resolve_topic_name(t) for t in topics))
         self.path = Path(self.p('output') or default_bag_name()).expanduser()
         self._lock = threading.Lock()
         self._writer = BagWriter(self.path, chunk_size=self.p('chunk_size'),

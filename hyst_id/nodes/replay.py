@@ -63,7 +63,7 @@ PARAMS = [
 
 
 def _qos(topic: str) -> QoSProfile:
-    latched = topic == IDENTIFIED_PARAMS_TOPIC
+    latched = ('/' + topic.lstrip('/')).endswith('/' + IDENTIFIED_PARAMS_TOPIC)
     return QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1 if latched else 1000,
                       reliability=ReliabilityPolicy.RELIABLE,
                       durability=(DurabilityPolicy.TRANSIENT_LOCAL if latched

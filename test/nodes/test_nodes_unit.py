@@ -99,7 +99,7 @@ def test_every_node_starts_with_defaults(ctx, tmp_path):
 
 
 def test_defaults_match_the_params_files():
-    """params/<node>.yaml holds exactly the built-in defaults."""
+    """params/<node>.yaml holds exactly the built-in defaults, under /** (any namespace)."""
     import importlib
     from pathlib import Path
 
@@ -108,7 +108,7 @@ def test_defaults_match_the_params_files():
     for name in ('actuator_driver', 'pipeline_sim', 'excitation', 'identifier', 'compensator',
                  'recorder', 'replay'):
         mod = importlib.import_module(f'hyst_id.nodes.{name}')
-        doc = yaml.safe_load((root / f'{name}.yaml').read_text())[name]['ros__parameters']
+        doc = yaml.safe_load((root / f'{name}.yaml').read_text())['/**']['ros__parameters']
         nested = doc.get('topics') if isinstance(doc.get('topics'), dict) else {}
         flat = {k: v for k, v in doc.items() if not (k == 'topics' and nested)}
         flat.update({f'topics.{k}': v for k, v in nested.items()})

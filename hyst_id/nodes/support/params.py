@@ -81,15 +81,17 @@ TOPIC_KEYS = ('command_topic',) + tuple(f'{ch}_topic' for ch in CHANNELS)
 
 
 def topic_params(keys: Iterable[str] = TOPIC_KEYS) -> list[Param]:
-    """Read-only ``topics.<key>`` parameters with the defaults of ``params/topics.yaml``."""
+    """Read-only ``topics.<key>`` parameters: ``params/topics.yaml``'s names, relative."""
     out = []
     for key in keys:
         if key == 'command_topic':
             default = TopicConfig().command_topic
         else:
             default = TopicConfig.for_channel(key[:-len('_topic')]).measurement_topic
-        out.append(Param(f'topics.{key}', default,
-                         f'topic name ({key.replace("_", " ")})', read_only=True))
+        # relative, so that the node's namespace applies (a bag's names are absolute)
+        out.append(Param(f'topics.{key}', default.lstrip('/'),
+                         f'topic name ({key.replace("_", " ")}); relative names take the '
+                         "node's namespace", read_only=True))
     return out
 
 

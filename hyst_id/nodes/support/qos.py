@@ -43,10 +43,11 @@ from rclpy.qos import (
 __all__ = ['COMMAND_QOS', 'DESIRED_TOPIC', 'DIAGNOSTICS_QOS', 'DIAGNOSTICS_TOPIC',
            'IDENTIFIED_PARAMS_TOPIC', 'LATCHED_QOS', 'SENSOR_QOS']
 
-#: Desired output fed to the compensator (std_msgs/Float64).
-DESIRED_TOPIC = '/hyst_id/desired'
-#: Latched JSON of the last identification (std_msgs/String).
-IDENTIFIED_PARAMS_TOPIC = '/hyst_id/identified_params'
+#: Desired output fed to the compensator (std_msgs/Float64); relative, so a
+#: node started in a namespace (``-r __ns:=/valve1``) uses ``/valve1/hyst_id/desired``.
+DESIRED_TOPIC = 'hyst_id/desired'
+#: Latched JSON of the last identification (std_msgs/String); relative, as above.
+IDENTIFIED_PARAMS_TOPIC = 'hyst_id/identified_params'
 #: Standard diagnostics topic (diagnostic_msgs/DiagnosticArray).
 DIAGNOSTICS_TOPIC = '/diagnostics'
 
