@@ -45,7 +45,7 @@ from hyst_id.identification.chains import (
 )
 from hyst_id.identification.domains import domains_from_data
 from hyst_id.identification.gauge import canonical_gauge, output_sign
-from hyst_id.identification.quality import identification_warnings
+from hyst_id.identification.quality import assess
 from hyst_id.identification.refine import refine
 from hyst_id.identification.result import Identification, IdentifySettings, SeedRun
 from hyst_id.identification.starts import data_starts
@@ -377,7 +377,8 @@ def identify(recording: Recording, *, spec: ChainSpec | None = None,
         if extra.fun < best.fun:
             runs.append(extra)
     ident = summarise(rec, spec, settings, runs)
-    ident.warnings += identification_warnings(ident, rec, spec)
+    warnings, ident.poorly_determined = assess(ident, rec, spec)
+    ident.warnings += warnings
     return ident
 
 

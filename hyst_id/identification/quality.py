@@ -55,11 +55,13 @@ if TYPE_CHECKING:
     from hyst_id.io.recording import Recording
 
 __all__ = [
+    'assess',
     'domain_edge_warnings',
     'fit_warnings',
     'identification_warnings',
     'orientation_warnings',
     'parameter_scales',
+    'poorly_determined',
     'poorly_determined_warnings',
     'unexcited_warnings',
 ]
@@ -98,6 +100,24 @@ def identification_warnings(ident: Identification, rec: Recording,
     list of str
         Warnings, most fundamental first.
     """
+    return assess(ident, rec, spec)[0]
+
+
+def assess(ident: Identification, rec: Recording,
+           spec: ChainSpec | None = None) -> tuple[list[str], dict[str, float]]:
+    """The warnings of :func:`identification_warnings` and the poorly determined names.
+
+    Returns
+    -------
+    warnings : list of str
+        As :func:`identification_warnings`.
+    poorly_determined : dict of str to float
+        Parameters whose spread over converged seeds or standard error
+        exceeds 5 % of their scale (:func:`poorly_determined`), each with
+        that relative uncertainty: what a quality gate looks at. Parameters
+        of unexcited lines are not among them: they do not act on commands
+        the recording visited.
+    """
     if spec is None:
         spec = replace(ident.spec(), calibration=None)
     out = orientation_warnings(rec, _sign(ident))
@@ -105,8 +125,9 @@ def identification_warnings(ident: Identification, rec: Recording,
     out += domain_edge_warnings(ident, rec, spec)
     unexcited, names = unexcited_warnings(ident, rec)
     out += unexcited
-    out += poorly_determined_warnings(ident, rec, skip=names)
-    return out
+    poor = poorly_determined(ident, rec, skip=names)
+    out += _poor_warning(poor)
+    return out, {name: rel for name, (rel, _) in sorted(poor.items())}
 
 
 def orientation_warnings(rec: Recording, sign: float = 1.0) -> list[str]:
@@ -319,13 +340,28 @@ def _standard_errors(ident: Identification, rec: Recording, sign: float) -> dict
 
 def poorly_determined_warnings(ident: Identification, rec: Recording,
                                skip: set[str] | frozenset = frozenset()) -> list[str]:
-    """Warn about parameters the data pins down poorly.
+    """Warn about parameters the data pins down poorly (:func:`poorly_determined`)."""
+    return _poor_warning(poorly_determined(ident, rec, skip))
+
+
+def _poor_warning(found: dict[str, tuple[float, str]]) -> list[str]:
+    if not found:
+        return []
+    return ['poorly determined by this recording: ' + '; '.join(t for _, t in found.values())
+            + ' -- treat these values with care (a longer or wider excitation helps)']
+
+
+def poorly_determined(ident: Identification, rec: Recording,
+                      skip: set[str] | frozenset = frozenset()) -> dict[str, tuple[float, str]]:
+    """Parameters the data pins down poorly: ``{name: (relative uncertainty, words)}``.
 
     A parameter is poorly determined when its spread (standard deviation)
     over the converged seeds (``%e_r`` within 10 % of the best; at least 3)
     or its standard error from the output sensitivity exceeds 5 % of its
     scale (:func:`parameter_scales`). Parameters in ``skip`` (already
-    reported as unexcited) and the gauge-fixed backlash are left out.
+    reported as unexcited) and the gauge-fixed backlash are left out. The
+    relative uncertainty is the larger of the two over the scale (``inf``
+    when the output does not depend on the parameter at all).
     """
     sign = _sign(ident)
     scales = parameter_scales(ident, rec)
@@ -336,7 +372,7 @@ def poorly_determined_warnings(ident: Identification, rec: Recording,
         xs = np.array([r.x for r in good])
         spread = dict(zip(ident.names, xs.std(axis=0)))
     errors = _standard_errors(ident, rec, sign)
-    found = []
+    found = {}
     for name, scale in scales.items():
         if name in skip or name == 'c_bl':
             continue
@@ -349,11 +385,9 @@ def poorly_determined_warnings(ident: Identification, rec: Recording,
                              f'{_percent(rel_spread)}')
             if name in errors:
                 parts.append(f'standard error {_percent(rel_error)}')
-            found.append(f'{name} ({", ".join(parts)} of its scale {scale:.3g})')
-    if not found:
-        return []
-    return ['poorly determined by this recording: ' + '; '.join(found)
-            + ' -- treat these values with care (a longer or wider excitation helps)']
+            found[name] = (float(max(rel_spread, rel_error)),
+                           f'{name} ({", ".join(parts)} of its scale {scale:.3g})')
+    return found
 
 
 def _sign(ident: Identification) -> float:

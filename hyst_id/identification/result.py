@@ -173,6 +173,9 @@ class Identification:
     domain_source: str
     settings: IdentifySettings
     warnings: list[str] = field(default_factory=list)
+    #: Parameters the recording pins down poorly, each with its uncertainty relative
+    #: to its scale (see ``quality.poorly_determined``; ``inf``: not determined at all).
+    poorly_determined: dict[str, float] = field(default_factory=dict)
     source: str = ''
     family: str = 'tk'
     initial: str = 'rising'
@@ -213,5 +216,8 @@ class Identification:
             'domain_source': self.domain_source,
             'settings': {k: (list(v) if isinstance(v, tuple) else v)
                          for k, v in asdict(self.settings).items()},
-            'warnings': list(self.warnings), 'runs': runs,
+            'warnings': list(self.warnings),
+            'poorly_determined': {k: (v if np.isfinite(v) else None)
+                                  for k, v in self.poorly_determined.items()},
+            'runs': runs,
         }

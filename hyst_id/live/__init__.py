@@ -34,7 +34,8 @@ installation:
   :func:`diagnosis_statuses` build what the node publishes.
 
 Modules: :mod:`.buffer` (samples), :mod:`.jobs` (worker threads),
-:mod:`.documents` (what the node publishes).
+:mod:`.documents` (what the node publishes), :mod:`.gate` (when a set is
+held back from the compensator).
 
 May import: :mod:`hyst_id.io`, :mod:`hyst_id.identification`, :mod:`hyst_id.compensation`,
 :mod:`hyst_id.diagnosis`; never rclpy.
@@ -49,8 +50,9 @@ from hyst_id.live.documents import (
                                     result_document,
                                     warm_up_kernels,
 )
+from hyst_id.live.gate import QualityGate
 from hyst_id.live.jobs import BackgroundJob, DiagnosisJob, IdentificationJob, JobCancelled
 
 __all__ = ['BackgroundJob', 'DiagnosisJob', 'IdentificationJob', 'JobCancelled',
-           'SampleBuffer', 'compensator_set', 'diagnosis_statuses', 'pair_streams',
+           'QualityGate', 'SampleBuffer', 'compensator_set', 'diagnosis_statuses', 'pair_streams',
            'recovered_document', 'result_document', 'warm_up_kernels']

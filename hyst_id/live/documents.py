@@ -32,6 +32,7 @@ from hyst_id.compensation.params_file import compensator_names
 from hyst_id.errors import InvalidParametersError
 from hyst_id.identification import Identification
 from hyst_id.identification.chains import chain_spec
+from hyst_id.live.gate import QualityGate
 
 __all__ = ['compensator_set', 'diagnosis_statuses', 'recovered_document', 'result_document',
            'warm_up_kernels']
@@ -58,16 +59,28 @@ def compensator_set(ident: Identification) -> tuple[dict | None, float, str]:
 
 
 def result_document(ident: Identification, n_samples: int, duration_s: float,
-                    notes: tuple[str, ...] | list[str] = ()) -> dict:
+                    notes: tuple[str, ...] | list[str] = (),
+                    gate: QualityGate | None = None) -> dict:
     """JSON-ready summary published on the identified-parameters topic.
 
     ``params`` and ``er_percent`` are the identification's (as ``hyst-id
     identify`` reports them); ``compensator_params`` / ``compensator_er_percent``
-    are the set the compensator should use (see :func:`compensator_set`);
+    are the set the compensator should use (see :func:`compensator_set`),
+    ``null`` when ``gate`` holds it back (``gate.reasons`` says why);
+    ``warnings`` and ``poorly_determined`` are the identification's;
     ``notes`` say what was sorted, dropped or missing in the samples.
     """
     comp, comp_er, note = compensator_set(ident)
+    gate = gate or QualityGate(max_floor_ratio=0.0, max_uncertainty=0.0)
+    reasons = gate.reasons(ident)
+    if reasons and comp is not None:
+        comp, comp_er = None, float('nan')
+        note = 'held back by the quality gate: ' + '; '.join(reasons)
     return {
+        'gate': gate.to_dict(reasons),
+        'warnings': list(getattr(ident, 'warnings', ()) or ()),
+        'poorly_determined': {k: (float(v) if np.isfinite(v) else None) for k, v in
+                              (getattr(ident, 'poorly_determined', None) or {}).items()},
         'compensator_params': comp, 'compensator_er_percent': comp_er,
         'compensator_note': note,
         'channel': ident.channel, 'family': ident.family, 'params': ident.params,

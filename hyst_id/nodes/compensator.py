@@ -62,9 +62,11 @@ from hyst_id.nodes.support import (
     IDENTIFIED_PARAMS_TOPIC,
     LATCHED_QOS,
     Param,
+    resolved,
     spin_node,
     topic_params,
     try_publish,
+    type_mismatches,
 )
 
 __all__ = ['ACTIVE_SET_QOS', 'Compensator', 'PARAMS', 'main']
@@ -109,7 +111,10 @@ PARAMS = [
     Param('initial_command', 9.0, 'command the actuator holds before the first sample',
           low=-1e6, high=1e6, unit='mA'),
     Param('follow_identified_params', True,
-          'apply parameter sets published on the identified-parameters topic'),
+          'apply parameter sets published on the identified-parameters topic (relative: the '
+          "node's namespace's identifier)"),
+    Param('require_model', False, 'without a valid parameter set, hold initial_command (or the '
+          'last command) instead of passing the desired value through, and report ERROR'),
     Param('diagnostics_period_s', 1.0, 'period of the /diagnostics status', low=0.05,
           high=3600.0, unit='s'),
     *topic_params(('command_topic',)),
@@ -167,17 +172,22 @@ class Compensator(HystNode):
         self._diag_timer = self.create_timer(values['diagnostics_period_s'],
                                              self._publish_status)
         log = self.get_logger()
-        log.info(f'compensating {self.p("topics.desired_topic")} -> '
-                 f'{self.p("topics.command_topic")}, command in [{values["min_command"]:g}, '
-                 f'{values["max_command"]:g}] mA')
+        log.info(f'compensating {resolved(self, self.p("topics.desired_topic"))} -> '
+                 f'{self._cmd_pub.topic_name}, command in [{values["min_command"]:g}, '
+                 f'{values["max_command"]:g}] mA'
+                 + (f'; following {resolved(self, self.p("topics.identified_params_topic"))}'
+                    if values['follow_identified_params'] else ''))
+        without = ('holding the initial command (require_model)' if values['require_model']
+                   else 'passing the desired value through unchanged')
         if model is not None:
             log.info(f'model from parameters: {self._describe(values)}')
         elif kind == 'incomplete':
-            log.warning(f'parameter set incomplete (unset: {", ".join(unset)}): passing the '
-                        'desired value through unchanged')
+            (log.error if values['require_model'] else log.warning)(
+                f'parameter set incomplete (unset: {", ".join(unset)}): {without}')
         else:
-            log.warning('no parameter set yet: passing the desired value through unchanged '
-                        'until one arrives (parameters, identified-params topic)')
+            (log.error if values['require_model'] else log.warning)(
+                f'no parameter set yet: {without} until one arrives (parameters'
+                + (', identified-params topic)' if values['follow_identified_params'] else ')'))
 
     # ---------------------------------------------------------------- params
     def validate_params(self, values: dict[str, Any], changed: set[str]) -> str | None:
@@ -223,8 +233,8 @@ class Compensator(HystNode):
                 self._comp.set_model(model)
                 if model is not None:
                     self._source = source
-                    self.get_logger().info(f'applied parameter set from {source}: '
-                                           f'{self._describe(values)}')
+                    self.get_logger().warning(f'applied parameter set from {source}: '
+                                              f'{self._describe(values)}')
                 elif kind == 'none':
                     self._source = ''
                     self.get_logger().warning('parameter set cleared: passing the desired '
@@ -267,7 +277,10 @@ class Compensator(HystNode):
     def _on_desired(self, msg: Float64) -> None:
         t_s = self.get_clock().now().nanoseconds * 1e-9
         t0 = time.perf_counter_ns()
-        v = self._comp.step(float(msg.data), t_s)
+        if self._comp.model is None and self.p('require_model'):
+            v = self._comp.state[0]           # hold: no model, no pass-through
+        else:
+            v = self._comp.step(float(msg.data), t_s)
         self._step_ns.append(time.perf_counter_ns() - t0)
         self._n += 1
         if not try_publish(self._cmd_pub, Float64(data=v)):
@@ -284,6 +297,15 @@ class Compensator(HystNode):
         log = self.get_logger()
         try:
             doc = json.loads(msg.data)
+            if 'compensator_params' in doc and doc['compensator_params'] is None:
+                log.warning('identified parameters not handed over: '
+                            + str(doc.get('compensator_note') or 'no compensator set'))
+                return
+            if str(doc.get('source', '')).startswith('recovered') \
+                    and self._source in ('params', 'set_parameters'):
+                log.warning(f'ignored the identifier\'s {doc["source"]}: this compensator\'s '
+                            f'set was loaded on purpose ({self._source}) and stays')
+                return
             params = doc.get('compensator_params') or doc.get('params', doc)
             channel = str(doc.get('channel', params.get('channel', '')))
             family = str(params.get('family', doc.get('family', DEFAULT_FAMILY)))
@@ -320,9 +342,18 @@ class Compensator(HystNode):
                   'er_percent': self.p('er_percent'), 'command': self._comp.state[0],
                   'generation': self._generation, 'rejected_updates': self.rejected_updates,
                   'commands_not_sent': self._not_sent}
-        if self._not_sent:
+        wrong = type_mismatches(self, self.p('topics.desired_topic'), 'std_msgs/msg/Float64')
+        if wrong:
+            text = (f'{resolved(self, self.p("topics.desired_topic"))}: {", ".join(wrong)}, '
+                    'expected std_msgs/msg/Float64 (never received)')
+            self.get_logger().error(text, throttle_duration_sec=10.0)
+            self.publish_diagnostics(2, text, values)
+        elif self._not_sent:
             self.publish_diagnostics(2, f'{self._not_sent} command(s) could not be sent (a '
                                      'subscriber stalled?)', values)
+        elif model is None and self.p('require_model'):
+            self.publish_diagnostics(2, 'no valid parameter set and require_model: holding '
+                                     'the command', values)
         elif model is None:
             self.publish_diagnostics(1, 'no valid parameter set: passing the desired value '
                                      'through unchanged', values)

@@ -52,12 +52,13 @@ from hyst_id.errors import ConfigError, HystIdError
 from hyst_id.identification import Identification, IdentifySettings
 from hyst_id.identification.config import make_settings, make_spec
 from hyst_id.identification.model_choice import AUTO_FAMILIES
-from hyst_id.io.recording import CHANNELS, Recording, validate_recording
+from hyst_id.io.recording import Recording, validate_recording
 from hyst_id.io.topics import get_field, parse_field_path, TopicConfig
 from hyst_id.live import (
     diagnosis_statuses,
     DiagnosisJob,
     IdentificationJob,
+    QualityGate,
     recovered_document,
     result_document,
     SampleBuffer,
@@ -66,18 +67,17 @@ from hyst_id.live import (
 from hyst_id.nodes.support import (
     COMMAND_QOS,
     diagnostic_array,
-    field_params,
     HystNode,
-    IDENTIFIED_PARAMS_TOPIC,
     LATCHED_QOS,
     message_class,
-    Param,
     ParameterPusher,
+    resolved,
     source_time_ns,
     spin_node,
     stamp_ns,
-    topic_params,
+    type_mismatches,
 )
+from hyst_id.nodes.support.identifier_params import PARAMS
 
 try:  # optional: std_srvs is not a dependency of the package
     from std_srvs.srv import Trigger
@@ -86,63 +86,6 @@ except ImportError:  # pragma: no cover - depends on the installation
 
 __all__ = ['Identifier', 'PARAMS', 'default_params_out', 'main']
 
-PARAMS = [
-    Param('channel', 'position', 'measured channel to identify', choices=CHANNELS,
-          read_only=True),
-    *topic_params(), *field_params(),
-    Param('topics.stamp_source', 'header', "'header': measurement header stamps; 'log': "
-          'source timestamps for everything (replays)', choices=('header', 'log'),
-          read_only=True),
-    Param('topics.identified_params_topic', IDENTIFIED_PARAMS_TOPIC,
-          'latched identified parameters (std_msgs/String, JSON)', read_only=True),
-    Param('measurement_reliable', False, 'subscribe to the measurement with reliable QoS '
-          '(for replays; live sensors are best effort)', read_only=True),
-    Param('collect', True, 'accumulate samples from the topics'),
-    Param('min_samples', 50, 'fewest samples an identification starts with', low=20,
-          high=100000000),
-    Param('max_samples', 2000000, 'samples kept (oldest dropped)', low=100, high=100000000),
-    Param('end_of_run_timeout_s', 2.0, 'identify when no measurement arrived for this long '
-          '(0 = only on request)', low=0.0, high=86400.0, unit='s'),
-    Param('identify_now', False, 'set true to identify the samples collected so far'),
-    Param('clear_after_identify', True, 'start a new run after each identification'),
-    Param('pop_size', 10, 'GAASS population size N_pop', low=2, high=100000),
-    Param('generations', 500, 'GAASS generations', low=1, high=10000000),
-    Param('c', 0.007, 'GAASS search-space contraction rate (Eq. 15)', low=1e-9, high=100.0),
-    Param('xi', 0.02, 'GAASS mutation subspace coefficient (Eq. 22)', low=1e-9, high=1.0),
-    Param('seeds', 10, 'number of seeds (one GAASS run each)', low=1, high=100000),
-    Param('seed_offset', 0, 'first seed', low=0, high=2**31 - 1),
-    Param('workers', 1, '1: seeds one after the other in a worker thread; 0: one worker '
-          'process per core; n > 1: n processes', low=0, high=1024),
-    Param('refine', True, 'polish each GAASS result with bounded least squares'),
-    Param('restarts', 4, 'extra GAASS runs per seed while %e_r stays above 1.05 x the noise '
-          'floor and they still gain (0 = one run per seed)', low=0, high=1000),
-    Param('er_bound_percent', 0.0, 'stop a GAASS run once %e_r is below this (0 = never)',
-          low=0.0, high=1000.0, unit='%'),
-    Param('domains', 'auto', "search domains: 'auto' (from the data), 'paper', or a YAML "
-          'file of name: [low, high]'),
-    Param('model', 'tk', "H's family: 'tk' (the paper's piecewise-linear loop), 'smooth' "
-          "(Prandtl-Ishlinskii, curved branches) or 'auto' (fit both on the first 70 % of the "
-          'run, keep the lower held-out error)', choices=('tk', 'smooth', 'auto')),
-    Param('params_out', '', 'compensator params file written after each identification '
-          "('' = $ROS_HOME/hyst_id/compensator.yaml)", read_only=True),
-    Param('recover_on_start', True, 'republish the parameter set found in params_out at '
-          'start (restart recovery)', read_only=True),
-    Param('compensator_node', '/compensator', 'node whose set_parameters_atomically service '
-          "receives the parameters ('' = do not push)"),
-    Param('push_timeout_s', 5.0, 'how long to wait for the compensator service', low=0.0,
-          high=3600.0, unit='s'),
-    Param('cancel_now', False, 'set true to cancel the running identification (the last '
-          'published parameters stay)'),
-    Param('diagnose_now', False, 'set true to diagnose the samples collected so far (else the '
-          'last identified run)'),
-    Param('diagnose_seeds', 2, 'GAASS seeds of the diagnosis baseline fit', low=1, high=1000),
-    Param('diagnose_generations', 200, 'GAASS generations of the diagnosis baseline fit',
-          low=1, high=10000000),
-    Param('diagnose_train_fraction', 0.7, 'share of the run the diagnosis fits on (the rest is '
-          'held out)', low=0.1, high=0.95),
-    Param('diagnose_mechanisms', '', "comma-separated mechanism ids to test ('' = the whole "
-          'library)'),
-]
 
 #: Depth of the best-effort measurement subscription's queue.
 SENSOR_QUEUE_DEPTH = 1000
@@ -177,10 +120,16 @@ class Identifier(HystNode):
         self._eor_tried = False
         self._requested: set[str] = set()
         self._pusher = ParameterPusher(self)
+        self._started = time.monotonic()
+        #: monotonic time each input stream was last received (not reset by a new run).
+        self._rx: dict[str, float] = {}
+        self._gate_message = ''
         self._cmd_field = parse_field_path(v['topics.command_field'])
         self._meas_field = parse_field_path(v[f'topics.{self.channel}_field'])
         self._meas_topic = v[f'topics.{self.channel}_topic']
         meas_type = v[f'topics.{self.channel}_type']
+        self._expected = ((v['topics.command_topic'], TopicConfig().command_type),
+                          (self._meas_topic, meas_type))
         self._stamp_header = v['topics.stamp_source'] == 'header'
         self._units = (TopicConfig().command_unit,
                        TopicConfig.for_channel(self.channel).measurement_unit)
@@ -212,8 +161,10 @@ class Identifier(HystNode):
         self.create_timer(0.02, self._tick)
         self.create_timer(1.0, self._status)
         self.get_logger().info(
-            f'identifying {self.channel} from {v["topics.command_topic"]} + {self._meas_topic}'
-            f' ({meas_type} {v[f"topics.{self.channel}_field"]}); trigger: end of run after '
+            f'identifying {self.channel} from {resolved(self, v["topics.command_topic"])} + '
+            f'{resolved(self, self._meas_topic)} ({meas_type} '
+            f'{v[f"topics.{self.channel}_field"]}); publishing on '
+            f'{self._result_pub.topic_name}; trigger: end of run after '
             f'{v["end_of_run_timeout_s"]:g} s idle, identify_now:=true'
             + (', ~/identify, ~/cancel, ~/diagnose services' if Trigger is not None else ''))
         if v['recover_on_start'] and self.params_out.is_file():
@@ -245,10 +196,12 @@ class Identifier(HystNode):
         return source_time_ns(self, info)
 
     def _on_command(self, msg: Float64, info: dict) -> None:
+        self._rx['command'] = time.monotonic()
         if self.p('collect'):
             self.buffer.add_command(self._stamp(msg, info), get_field(msg, self._cmd_field))
 
     def _on_measurement(self, msg: Any, info: dict) -> None:
+        self._rx['measurement'] = time.monotonic()
         if not self.p('collect'):
             return
         try:
@@ -404,8 +357,13 @@ class Identifier(HystNode):
         ident = job.result
         self.last_identification = ident
         self._last_rec = job.rec
-        doc = result_document(ident, job.rec.n_samples, job.rec.duration_s, job.rec.notes)
+        gate = QualityGate(self.p('gate_max_floor_ratio'), self.p('gate_max_uncertainty'))
+        doc = result_document(ident, job.rec.n_samples, job.rec.duration_s, job.rec.notes,
+                              gate=gate)
         comp = doc['compensator_params']
+        if comp is None and not doc['gate']['passed']:
+            self._publish_held_back(job, doc)
+            return
         if comp is None:
             self._fail(f'identified {ident.channel} (%e_r {ident.er_percent:.3f}) but '
                        f'{doc["compensator_note"]}; {self._kept()}')
@@ -417,12 +375,18 @@ class Identifier(HystNode):
                 + f' -> {job.choice.chosen}')
         self.last_document = doc
         self.last_error = ''
+        self._gate_message = ''
         self._result_pub.publish(String(data=json.dumps(doc)))
         self.get_logger().info(
             f'identified {ident.channel} in {job.elapsed_s:.1f} s: %e_r '
             f'{ident.er_percent:.3f} (noise floor {ident.noise_floor_percent:.3f}); '
             + ', '.join(f'{n}={ident.params[n]:.4g}' for n in ident.names))
-        self.publish_diagnostics(0, f'identified {ident.channel}: %e_r {ident.er_percent:.3f}',
+        for w in ident.warnings:
+            self.get_logger().warning(f'identification: {w}')
+        self.publish_diagnostics(1 if ident.warnings else 0,
+                                 f'identified {ident.channel}: %e_r {ident.er_percent:.3f}'
+                                 + (f'; {len(ident.warnings)} warning(s): '
+                                    + ' | '.join(ident.warnings) if ident.warnings else ''),
                                  {'er_percent': ident.er_percent, 'elapsed_s': job.elapsed_s})
         values = compensator_values({**comp, 'channel': ident.channel,
                                      'er_percent': doc['compensator_er_percent']})
@@ -437,6 +401,42 @@ class Identifier(HystNode):
                               self.p('push_timeout_s'))
         if self.on_identified is not None:
             self.on_identified(doc)
+
+    def _publish_held_back(self, job: IdentificationJob, doc: dict) -> None:
+        """Publish a result the quality gate holds back: nothing is handed over."""
+        ident = job.result
+        self.last_identification = ident
+        self._last_rec = job.rec
+        self.last_document = doc
+        self.last_error = ''
+        self._result_pub.publish(String(data=json.dumps(doc)))
+        self._gate_message = (
+            f'identified {ident.channel} (%e_r {ident.er_percent:.3f}, noise floor '
+            f'{ident.noise_floor_percent:.3f}) but held it back: '
+            + '; '.join(doc['gate']['reasons'])
+            + f'; the compensator and {self.params_out} keep their set (relax '
+            'gate_max_floor_ratio / gate_max_uncertainty to hand such sets over)')
+        self.get_logger().warning(self._gate_message)
+        self.publish_diagnostics(1, self._gate_message, {'er_percent': ident.er_percent})
+        if self.on_identified is not None:
+            self.on_identified(doc)
+
+    def _input_problems(self) -> list[str]:
+        """Inputs of a wrong type, or one input arriving while the other does not."""
+        out = []
+        for topic, expected in self._expected:
+            for m in type_mismatches(self, topic, expected):
+                out.append(f'{resolved(self, topic)}: {m}, expected {expected} (never '
+                           'received)')
+        now, tmo = time.monotonic(), self.p('input_timeout_s')
+        if now - self._started > tmo:
+            live = {k for k, t in self._rx.items() if now - t < tmo}
+            topics = {'command': self.p('topics.command_topic'), 'measurement': self._meas_topic}
+            for have, lack in (('command', 'measurement'), ('measurement', 'command')):
+                if have in live and lack not in live:
+                    out.append(f'{have}s arrive on {resolved(self, topics[have])} but no '
+                               f'{lack} on {resolved(self, topics[lack])} for {tmo:g} s')
+        return out
 
     def _publish_diagnosis(self, doc: dict, elapsed_s: float) -> None:
         self.last_diagnosis = doc
@@ -481,8 +481,14 @@ class Identifier(HystNode):
                         f'{prog["generation"]}, %e_r {prog["seed_er_percent"]:.3f}')
         elif self.last_error:
             level, msg = 2, self.last_error
+        elif self._gate_message:
+            level, msg = 1, self._gate_message
         elif self.last_document:
             values['last_er_percent'] = self.last_document.get('er_percent') or math.nan
+        problems = self._input_problems()
+        if problems:
+            level, msg = 2, '; '.join(problems) + f' ({msg})'
+            self.get_logger().error('; '.join(problems), throttle_duration_sec=10.0)
         self.publish_diagnostics(level, msg, values, extra=self._diag_statuses)
 
     def destroy_node(self) -> None:

@@ -16,6 +16,7 @@
 
 from __future__ import annotations
 
+import math
 from types import SimpleNamespace
 
 import numpy as np
@@ -174,3 +175,19 @@ def test_recovered_document_carries_the_set():
 def test_recording_of_an_empty_buffer_says_so():
     with pytest.raises(RecordingError, match='0 commands'):
         SampleBuffer().recording('position')
+
+
+def test_quality_gate_reasons():
+    from hyst_id.live import QualityGate
+    ident = SimpleNamespace(er_percent=0.5, noise_floor_percent=0.1,
+                            poorly_determined={'m_t': 0.2, 'c_br': math.inf})
+    reasons = QualityGate().reasons(ident)
+    assert len(reasons) == 2 and '5.0 x the noise floor' in reasons[0]
+    assert 'c_br (uncertainty unbounded' in reasons[1] and 'm_t' not in reasons[1]
+    assert QualityGate(max_floor_ratio=6.0, max_uncertainty=0.0).reasons(ident) == []
+    assert QualityGate(max_floor_ratio=0.0, max_uncertainty=0.1).reasons(ident)[0].count(
+        'uncertainty') == 2
+    ident.noise_floor_percent = math.nan              # no floor: only the uncertainty counts
+    assert len(QualityGate().reasons(ident)) == 1
+    assert QualityGate().to_dict([]) == {'passed': True, 'reasons': [], 'max_floor_ratio': 3.0,
+                                         'max_uncertainty': 1.0}

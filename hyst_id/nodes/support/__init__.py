@@ -33,16 +33,19 @@ from hyst_id.nodes.support.ros import (
                                        diagnostic_array,
                                        init_ros,
                                        message_class,
+                                       resolved,
                                        source_time_ns,
                                        spin_in_background,
                                        spin_node,
                                        stamp_ns,
                                        try_publish,
+                                       type_mismatches,
 )
 
 __all__ = [
     'COMMAND_QOS', 'DESIRED_TOPIC', 'DIAGNOSTICS_QOS', 'DIAGNOSTICS_TOPIC', 'HystNode',
     'IDENTIFIED_PARAMS_TOPIC', 'LATCHED_QOS', 'Param', 'ParameterPusher', 'SENSOR_QOS',
     'TOPIC_KEYS', 'diagnostic_array', 'field_params', 'init_ros', 'message_class',
-    'source_time_ns', 'spin_in_background', 'spin_node', 'stamp_ns', 'topic_params', 'try_publish',
+    'resolved', 'source_time_ns', 'spin_in_background', 'spin_node', 'stamp_ns', 'topic_params',
+    'try_publish', 'type_mismatches',
 ]

@@ -16,7 +16,7 @@
 
 from __future__ import annotations
 
-from typing import Any, Mapping, Sequence
+from typing import Any, Iterable, Mapping, Sequence
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from rcl_interfaces.msg import SetParametersResult
@@ -28,14 +28,34 @@ from rclpy.exceptions import (
 from rclpy.node import Node
 
 from hyst_id.errors import ConfigError
+from hyst_id.io.topics import TOPIC_FILE_KEYS
 from hyst_id.nodes.support.params import Param
 from hyst_id.nodes.support.qos import DIAGNOSTICS_QOS, DIAGNOSTICS_TOPIC
 from hyst_id.nodes.support.ros import diagnostic_array, first_line, try_publish
 
-__all__ = ['HystNode']
+__all__ = ['HystNode', 'unknown_overrides']
 
 _TYPE_NAMES = {bool: 'a bool', int: 'an integer', float: 'a double', str: 'a string',
                list: 'an array'}
+
+
+#: Parameters rclpy itself reads, and prefixes of parameter families it owns.
+_ROS_OWN = frozenset({'use_sim_time', 'start_type_description_service'})
+_ROS_OWN_PREFIXES = ('qos_overrides.',)
+
+
+def unknown_overrides(overrides: Iterable[str], declared: Iterable[str]) -> list[str]:
+    """Names given by a params file or ``-p`` that no parameter of the node matches.
+
+    Keys of the shared ``params/topics.yaml`` (``topics.<channel>_topic`` ...,
+    given to every node through ``/**``) and rclpy's own parameters are not
+    unknown; anything else (a typo such as ``max_comand``, another node's
+    key) is.
+    """
+    declared = set(declared)
+    shared = {f'topics.{k}' for k in TOPIC_FILE_KEYS}
+    return sorted(n for n in overrides if n not in declared and n not in shared
+                  and n not in _ROS_OWN and not n.startswith(_ROS_OWN_PREFIXES))
 
 
 class HystNode(Node):
@@ -57,7 +77,10 @@ class HystNode(Node):
     Subclasses override :meth:`validate_params` (cross-parameter checks,
     return a reason string to reject) and :meth:`apply_params` (act on an
     accepted change). Startup values are validated too: an invalid params
-    file raises :class:`~hyst_id.errors.ConfigError`.
+    file raises :class:`~hyst_id.errors.ConfigError`. A params-file key no
+    parameter matches (:func:`unknown_overrides`) is logged as an error and
+    reported every second on ``/diagnostics`` (ERROR, status
+    ``hyst_id: <node>: parameters``) for the node's life: it was ignored.
     """
 
     def __init__(self, node_name: str, params: Sequence[Param],
@@ -87,6 +110,16 @@ class HystNode(Node):
         if reason:
             raise ConfigError(f'invalid parameters: {reason}')
         self.add_on_set_parameters_callback(self._on_set_parameters)
+        #: Params-file / ``-p`` names that match no parameter (ignored).
+        self.unknown_parameters = unknown_overrides(
+            getattr(self, '_parameter_overrides', {}), self._param_table)
+        if self.unknown_parameters:
+            self._unknown_message = (
+                f'unknown parameter(s) ignored: {", ".join(self.unknown_parameters)} (a typo, '
+                f'or a key of another node?); {node_name} declares: '
+                + ', '.join(sorted(n for n in self._param_table if not n.startswith('topics.'))))
+            self.get_logger().error(self._unknown_message)
+            self.create_timer(1.0, self._report_unknown)
 
     # --------------------------------------------------------------- params
     def param_values(self) -> dict[str, Any]:
@@ -135,6 +168,14 @@ class HystNode(Node):
         return SetParametersResult(successful=True)
 
     # ---------------------------------------------------------- diagnostics
+    def _report_unknown(self) -> None:
+        if self._diag_pub is None:
+            self._diag_pub = self.create_publisher(DiagnosticArray, DIAGNOSTICS_TOPIC,
+                                                   DIAGNOSTICS_QOS)
+        try_publish(self._diag_pub, diagnostic_array(
+            self, f'hyst_id: {self.get_name()}: parameters', 2, self._unknown_message,
+            {'unknown': ', '.join(self.unknown_parameters)}))
+
     def publish_diagnostics(self, level: int, message: str,
                             values: Mapping[str, Any] | None = None,
                             extra: Sequence[DiagnosticStatus] = ()) -> None:

@@ -34,8 +34,9 @@ from rclpy.node import Node
 
 from hyst_id.errors import ConfigError, HystIdError
 
-__all__ = ['diagnostic_array', 'first_line', 'init_ros', 'message_class', 'source_time_ns',
-           'spin_in_background', 'spin_node', 'stamp_ns', 'try_publish']
+__all__ = ['diagnostic_array', 'first_line', 'init_ros', 'message_class', 'resolved',
+           'source_time_ns', 'spin_in_background', 'spin_node', 'stamp_ns', 'try_publish',
+           'type_mismatches']
 
 _RCLError = _rclpy.RCLError
 
@@ -144,6 +145,30 @@ def diagnostic_array(node: Node, name: str, level: int | bytes, message: str,
     arr.header.stamp = node.get_clock().now().to_msg()
     arr.status.append(status)
     return arr
+
+
+def type_mismatches(node: Node, topic: str, expected: str) -> list[str]:
+    """Publishers on ``topic`` whose message type is not ``expected``, in words.
+
+    ``topic`` may be relative (the node's namespace and remaps apply);
+    ``expected`` is a full type name such as ``std_msgs/msg/Float64``. A
+    subscriber never receives what such a publisher sends (the middleware
+    does not match them), so without this check a wrong type is silence.
+    """
+    try:
+        infos = node.get_publishers_info_by_topic(node.resolve_topic_name(topic))
+    except Exception:  # noqa: BLE001 - a graph query must never stop the node
+        return []
+    return sorted({f'{(i.node_namespace.rstrip("/") + "/" + i.node_name)} publishes '
+                   f'{i.topic_type}' for i in infos if i.topic_type != expected})
+
+
+def resolved(node: Node, topic: str) -> str:
+    """``topic`` as the middleware sees it: namespace and remaps applied."""
+    try:
+        return node.resolve_topic_name(topic)
+    except Exception:  # noqa: BLE001 - only for log lines; the name itself is checked later
+        return topic
 
 
 def first_line(exc: BaseException) -> str:

@@ -1,0 +1,89 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""The identifier node's parameter table (:mod:`hyst_id.nodes.identifier`)."""
+
+from __future__ import annotations
+
+from hyst_id.io.recording import CHANNELS
+from hyst_id.nodes.support.params import field_params, Param, topic_params
+from hyst_id.nodes.support.qos import IDENTIFIED_PARAMS_TOPIC
+
+__all__ = ['PARAMS']
+
+PARAMS = [
+    Param('channel', 'position', 'measured channel to identify', choices=CHANNELS,
+          read_only=True),
+    *topic_params(), *field_params(),
+    Param('topics.stamp_source', 'header', "'header': measurement header stamps; 'log': "
+          'source timestamps for everything (replays)', choices=('header', 'log'),
+          read_only=True),
+    Param('topics.identified_params_topic', IDENTIFIED_PARAMS_TOPIC,
+          'latched identified parameters (std_msgs/String, JSON)', read_only=True),
+    Param('measurement_reliable', False, 'subscribe to the measurement with reliable QoS '
+          '(for replays; live sensors are best effort)', read_only=True),
+    Param('collect', True, 'accumulate samples from the topics'),
+    Param('min_samples', 50, 'fewest samples an identification starts with', low=20,
+          high=100000000),
+    Param('max_samples', 2000000, 'samples kept (oldest dropped)', low=100, high=100000000),
+    Param('end_of_run_timeout_s', 2.0, 'identify when no measurement arrived for this long '
+          '(0 = only on request)', low=0.0, high=86400.0, unit='s'),
+    Param('identify_now', False, 'set true to identify the samples collected so far'),
+    Param('clear_after_identify', True, 'start a new run after each identification'),
+    Param('pop_size', 10, 'GAASS population size N_pop', low=2, high=100000),
+    Param('generations', 500, 'GAASS generations', low=1, high=10000000),
+    Param('c', 0.007, 'GAASS search-space contraction rate (Eq. 15)', low=1e-9, high=100.0),
+    Param('xi', 0.02, 'GAASS mutation subspace coefficient (Eq. 22)', low=1e-9, high=1.0),
+    Param('seeds', 10, 'number of seeds (one GAASS run each)', low=1, high=100000),
+    Param('seed_offset', 0, 'first seed', low=0, high=2**31 - 1),
+    Param('workers', 1, '1: seeds one after the other in a worker thread; 0: one worker '
+          'process per core; n > 1: n processes', low=0, high=1024),
+    Param('refine', True, 'polish each GAASS result with bounded least squares'),
+    Param('restarts', 4, 'extra GAASS runs per seed while %e_r stays above 1.05 x the noise '
+          'floor and they still gain (0 = one run per seed)', low=0, high=1000),
+    Param('er_bound_percent', 0.0, 'stop a GAASS run once %e_r is below this (0 = never)',
+          low=0.0, high=1000.0, unit='%'),
+    Param('domains', 'auto', "search domains: 'auto' (from the data), 'paper', or a YAML "
+          'file of name: [low, high]'),
+    Param('model', 'tk', "H's family: 'tk' (the paper's piecewise-linear loop), 'smooth' "
+          "(Prandtl-Ishlinskii, curved branches) or 'auto' (fit both on the first 70 % of the "
+          'run, keep the lower held-out error)', choices=('tk', 'smooth', 'auto')),
+    Param('params_out', '', 'compensator params file written after each identification '
+          "('' = $ROS_HOME/hyst_id/compensator.yaml)", read_only=True),
+    Param('recover_on_start', True, 'republish the parameter set found in params_out at '
+          'start (restart recovery)', read_only=True),
+    Param('compensator_node', 'compensator', 'node whose set_parameters_atomically service '
+          "receives the parameters ('' = do not push)"),
+    Param('gate_max_floor_ratio', 3.0, 'quality gate: hand no set over (params_out, '
+          'compensator_node, compensator_params) whose %e_r exceeds this multiple of the '
+          'noise floor (0 = no limit)', low=0.0, high=1e6),
+    Param('gate_max_uncertainty', 1.0, 'quality gate: hand no set over in which a '
+          "parameter's uncertainty (seed spread or standard error) exceeds this fraction of "
+          'its scale (0 = no limit)', low=0.0, high=1e6),
+    Param('input_timeout_s', 5.0, 'report ERROR when commands arrive but no measurement has '
+          'for this long (and the reverse)', low=0.1, high=86400.0, unit='s'),
+    Param('push_timeout_s', 5.0, 'how long to wait for the compensator service', low=0.0,
+          high=3600.0, unit='s'),
+    Param('cancel_now', False, 'set true to cancel the running identification (the last '
+          'published parameters stay)'),
+    Param('diagnose_now', False, 'set true to diagnose the samples collected so far (else the '
+          'last identified run)'),
+    Param('diagnose_seeds', 2, 'GAASS seeds of the diagnosis baseline fit', low=1, high=1000),
+    Param('diagnose_generations', 200, 'GAASS generations of the diagnosis baseline fit',
+          low=1, high=10000000),
+    Param('diagnose_train_fraction', 0.7, 'share of the run the diagnosis fits on (the rest is '
+          'held out)', low=0.1, high=0.95),
+    Param('diagnose_mechanisms', '', "comma-separated mechanism ids to test ('' = the whole "
+          'library)'),
+]

@@ -1,0 +1,202 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""Wiring into a larger stack (issue 15): namespaces, hand-over, loud mistakes.
+
+* relative topics and ``/**`` params files: two valves in two namespaces on
+  one domain do not cross, and a params file written by one identifier
+  loads into a compensator in any namespace;
+* the quality gate holds a set back (no push, no params file, WARN);
+* restart recovery never overwrites a set loaded on purpose;
+* mistakes are loud: unknown params-file keys, a model required but absent,
+  a wrong message type on an input, one input arriving without the other.
+"""
+
+from __future__ import annotations
+
+import json
+
+from conftest import make_node, spin_nodes_until
+import pytest
+
+rclpy = pytest.importorskip('rclpy')
+
+from diagnostic_msgs.msg import DiagnosticArray  # noqa: E402, I100
+from rclpy.node import Node  # noqa: E402
+from rclpy.parameter import Parameter  # noqa: E402
+from std_msgs.msg import Float64, String  # noqa: E402
+from test_identifier_node import _feed, _samples, FAST, PAPER  # noqa: E402
+
+from hyst_id.compensation.params_file import (  # noqa: E402
+    read_compensator_params,
+    write_compensator_params,
+)
+from hyst_id.nodes.compensator import Compensator  # noqa: E402
+from hyst_id.nodes.identifier import Identifier  # noqa: E402
+from hyst_id.nodes.support import COMMAND_QOS, LATCHED_QOS  # noqa: E402
+from hyst_id.nodes.support.hyst_node import unknown_overrides  # noqa: E402
+
+pytestmark = pytest.mark.ros
+
+
+def _spin_until(ctx, predicate, timeout=10.0):
+    return spin_nodes_until(ctx[0], ctx[1], predicate, timeout)
+
+
+def _statuses(ctx, name='diag_listener'):
+    """Every DiagnosticStatus published on /diagnostics, as (name, level, message)."""
+    got = []
+    node = make_node(ctx, Node, name)
+    node.create_subscription(
+        DiagnosticArray, '/diagnostics',
+        lambda a: got.extend((s.name, int.from_bytes(s.level, 'little'), s.message)
+                             for s in a.status), 10)
+    return got
+
+
+def _identify(ctx, ident):
+    _feed(ident, *_samples())
+    assert ident.request_identification('test')[0]
+    assert _spin_until(ctx, lambda: ident.job is None and ident.last_document is not None,
+                       timeout=120.0), ident.last_error
+
+
+def test_two_namespaced_valves_do_not_cross(ctx, tmp_path):
+    out = tmp_path / 'valve1.yaml'
+    ident = make_node(ctx, Identifier, namespace='/valve1', parameter_overrides=FAST + [
+        Parameter('params_out', value=str(out))])
+    comp1 = make_node(ctx, Compensator, namespace='/valve1')
+    comp2 = make_node(ctx, Compensator, namespace='/valve2')
+    assert ident._result_pub.topic_name == '/valve1/hyst_id/identified_params'
+    assert comp2._cmd_pub.topic_name == '/valve2/hyst_id/command'
+    _identify(ctx, ident)
+    assert _spin_until(ctx, lambda: comp1.model is not None, timeout=10.0)
+    _spin_until(ctx, lambda: False, timeout=1.0)
+    assert comp2.model is None                       # valve 2 never took valve 1's set
+    # the params file is keyed /** and loads into a compensator in any namespace
+    assert '/**:' in out.read_text().splitlines()
+    comp3 = make_node(ctx, Compensator, namespace='/spare/valve1',
+                      cli_args=['--ros-args', '--params-file', str(out)])
+    assert comp3.model is not None and comp3._source == 'params'
+    assert comp3.p('m_l') == pytest.approx(read_compensator_params(out)['m_l'], rel=1e-12)
+
+
+def test_the_quality_gate_holds_a_set_back(ctx, tmp_path):
+    out = tmp_path / 'comp.yaml'
+    statuses = _statuses(ctx)
+    ident = make_node(ctx, Identifier, parameter_overrides=FAST + [
+        Parameter('params_out', value=str(out)),
+        Parameter('gate_max_floor_ratio', value=0.5)])   # a fit at the floor is ~1 x
+    comp = make_node(ctx, Compensator)
+    _identify(ctx, ident)
+    doc = ident.last_document
+    assert doc['compensator_params'] is None and not doc['gate']['passed']
+    assert 'x the noise floor' in doc['gate']['reasons'][0]
+    assert 'held back by the quality gate' in doc['compensator_note']
+    assert _spin_until(ctx, lambda: any(n == 'hyst_id: identifier' and lvl == 1
+                                        and 'held it back' in m for n, lvl, m in statuses),
+                       timeout=5.0)
+    assert not out.exists() and comp.model is None   # nothing handed over
+
+
+def test_the_gate_passes_a_good_fit_with_its_warnings_in_the_document(ctx, tmp_path):
+    ident = make_node(ctx, Identifier, parameter_overrides=FAST + [
+        Parameter('params_out', value=str(tmp_path / 'comp.yaml'))])
+    _identify(ctx, ident)
+    doc = ident.last_document
+    assert doc['gate']['passed'] and doc['compensator_params'] is not None
+    assert isinstance(doc['warnings'], list) and isinstance(doc['poorly_determined'], dict)
+    assert json.loads(json.dumps(doc)) == doc
+
+
+def test_recovery_does_not_overwrite_a_set_loaded_on_purpose(ctx, tmp_path):
+    stale = tmp_path / 'stale.yaml'
+    write_compensator_params({'channel': 'position', 'params': {**PAPER, 'c_br': 0.3},
+                              'er_percent': 0.5}, stale)
+    comp = make_node(ctx, Compensator, parameter_overrides=[
+        Parameter(k, value=v) for k, v in PAPER.items()])
+    assert comp._source == 'params'
+    make_node(ctx, Identifier, parameter_overrides=FAST + [
+        Parameter('params_out', value=str(stale))])          # republishes the stale set
+    _spin_until(ctx, lambda: False, timeout=1.5)
+    assert comp.p('c_br') == 0.25                          # the set loaded on purpose stays
+    follower = make_node(ctx, Compensator,                 # one without a set takes it
+                         cli_args=['--ros-args', '-r', '__node:=follower'])
+    assert _spin_until(ctx, lambda: follower.model is not None, timeout=5.0)
+    assert follower.p('c_br') == 0.3
+
+
+def test_unknown_parameters_are_an_error(ctx, tmp_path):
+    assert unknown_overrides(['max_comand', 'topics.flow_topic', 'use_sim_time',
+                              'qos_overrides./x.publisher.depth', 'm_l'],
+                             ['m_l', 'max_command']) == ['max_comand']
+    params = tmp_path / 'typo.yaml'
+    params.write_text('/**:\n  ros__parameters:\n    max_comand: 21.0\n'
+                      '    topics:\n      flow_topic: hyst_id/flow\n')
+    statuses = _statuses(ctx)
+    comp = make_node(ctx, Compensator, cli_args=['--ros-args', '--params-file', str(params)])
+    assert comp.unknown_parameters == ['max_comand']
+    assert comp.p('max_command') == 20.0
+    assert _spin_until(ctx, lambda: any(n == 'hyst_id: compensator: parameters' and lvl == 2
+                                        and 'max_comand' in m for n, lvl, m in statuses),
+                       timeout=5.0)
+    good = make_node(ctx, Compensator, cli_args=['--ros-args', '-r', '__node:=good'])
+    assert good.unknown_parameters == []
+
+
+def test_require_model_holds_the_command_and_reports_error(ctx):
+    statuses = _statuses(ctx)
+    make_node(ctx, Compensator, parameter_overrides=[
+        Parameter('require_model', value=True), Parameter('initial_command', value=9.0),
+        Parameter('diagnostics_period_s', value=0.2)])
+    io = make_node(ctx, Node, 'io')
+    commands = []
+    io.create_subscription(Float64, 'hyst_id/command', lambda m: commands.append(m.data),
+                           COMMAND_QOS)
+    pub = io.create_publisher(Float64, 'hyst_id/desired', COMMAND_QOS)
+    io.create_timer(0.05, lambda: pub.publish(Float64(data=15.0)))
+    assert _spin_until(ctx, lambda: len(commands) >= 3, timeout=10.0)
+    assert set(commands) == {9.0}                          # held, never passed through
+    assert _spin_until(ctx, lambda: any(n == 'hyst_id: compensator' and lvl == 2
+                                        and 'require_model' in m for n, lvl, m in statuses),
+                       timeout=5.0)
+
+
+def test_a_wrong_message_type_on_the_desired_topic_is_an_error(ctx):
+    statuses = _statuses(ctx)
+    make_node(ctx, Compensator, parameter_overrides=[
+        Parameter('diagnostics_period_s', value=0.2)])
+    other = rclpy.Context()            # another participant, as another process would be
+    rclpy.init(context=other)
+    try:
+        io = Node('io', context=other)
+        io.create_publisher(String, 'hyst_id/desired', LATCHED_QOS)
+        assert _spin_until(ctx, lambda: any(n == 'hyst_id: compensator' and lvl == 2
+                                            and 'std_msgs/msg/String' in m
+                                            for n, lvl, m in statuses), timeout=10.0)
+        io.destroy_node()
+    finally:
+        other.try_shutdown()
+
+
+def test_commands_without_measurements_are_an_error(ctx):
+    statuses = _statuses(ctx)
+    make_node(ctx, Identifier, parameter_overrides=FAST + [
+        Parameter('input_timeout_s', value=0.3)])
+    io = make_node(ctx, Node, 'io')
+    pub = io.create_publisher(Float64, 'hyst_id/command', COMMAND_QOS)
+    io.create_timer(0.05, lambda: pub.publish(Float64(data=9.0)))
+    assert _spin_until(ctx, lambda: any(n == 'hyst_id: identifier' and lvl == 2
+                                        and 'no measurement' in m for n, lvl, m in statuses),
+                       timeout=10.0)
