@@ -58,6 +58,7 @@ import zlib
 
 import numpy as np
 from rosbags.highlevel import AnyReader, AnyReaderError
+from rosbags.interfaces import QosDurability
 from rosbags.rosbag2 import ReaderError, StoragePlugin, Writer, WriterError
 from rosbags.rosbag2.storage_mcap import McapWriter
 from rosbags.serde import SerdeError
@@ -70,6 +71,7 @@ from rosbags.typesys import (
 )
 
 from hyst_id.errors import ConfigError, MissingTopicError, RecordingError
+from hyst_id.io.bag_metadata import fix_metadata, rosbags_qos
 from hyst_id.io.mcap_recover import lacks_footer, scan_records
 from hyst_id.io.messages import at_path, build_message, merge
 from hyst_id.io.topics import parse_field_path, TopicConfig
@@ -198,14 +200,24 @@ class BagWriter:
         self.close()
         return False
 
-    def add_topic(self, name: str, msgtype: str) -> None:
-        """Register topic ``name`` carrying ``msgtype`` (e.g. ``'std_msgs/msg/Float64'``)."""
+    def add_topic(self, name: str, msgtype: str,
+                  offered_qos: Sequence[Mapping[str, Any]] = ()) -> None:
+        """Register topic ``name`` carrying ``msgtype`` (e.g. ``'std_msgs/msg/Float64'``).
+
+        ``offered_qos`` are the publishers' QoS profiles as mappings of rmw
+        values (``history``, ``depth``, ``reliability``, ``durability``,
+        ``liveliness`` as rmw enum integers; ``deadline_ns``, ``lifespan_ns``,
+        ``liveliness_lease_duration_ns``; ``avoid_ros_namespace_conventions``),
+        stored in the bag as ``ros2 bag record`` stores them, so that a
+        player can offer the same (a latched topic replays latched).
+        """
         if msgtype not in self.typestore.types:
             raise ConfigError(f'unknown message type {msgtype!r} for topic {name}')
         if name in self._connections:
             raise ValueError(f'topic {name} already added')
         self._connections[name] = self._writer.add_connection(
-            name, msgtype, typestore=self.typestore)
+            name, msgtype, typestore=self.typestore,
+            offered_qos_profiles=[rosbags_qos(q) for q in offered_qos])
 
     def write(self, topic: str, t_ns: int, msg: Any) -> None:
         """Write one message with log time ``t_ns`` (integer nanoseconds).
@@ -245,6 +257,7 @@ class BagWriter:
             self._open = False
             try:
                 self._writer.close()
+                fix_metadata(self.path / 'metadata.yaml')
             except (WriterError, OSError) as exc:
                 self._writer.abort()
                 raise RecordingError(f'cannot finish bag {self.path}: {exc}') from None
@@ -264,6 +277,8 @@ class BagContents:
         Topic name to message count.
     notes : list of str
         What was unusual (no ``metadata.yaml``, truncated file recovered).
+    latched : set of str
+        Topics every recorded publisher offered transient local (latched).
     """
 
     path: Path
@@ -271,6 +286,7 @@ class BagContents:
     counts: dict[str, int]
     notes: list[str] = field(default_factory=list)
     _source: Any = None
+    latched: set[str] = field(default_factory=set)
 
     def check_topics(self, topics: Sequence[str]) -> None:
         """Raise :class:`MissingTopicError` if one of ``topics`` is not in the bag."""
@@ -353,9 +369,13 @@ def open_bag(path: str | Path, *, recover_truncated: bool = False) -> Iterator[B
     try:
         topics: dict[str, str] = {}
         counts: dict[str, int] = {}
+        latched: set[str] = set()
         for conn in reader.connections:
             topics[conn.topic] = conn.msgtype
             counts[conn.topic] = counts.get(conn.topic, 0) + conn.msgcount
+            offered = getattr(conn.ext, 'offered_qos_profiles', None) or []
+            if offered and all(q.durability == QosDurability.TRANSIENT_LOCAL for q in offered):
+                latched.add(conn.topic)
 
         def source(wanted: set[str]) -> Iterator[tuple[str, str, int, Any]]:
             conns = [c for c in reader.connections if c.topic in wanted]
@@ -364,7 +384,7 @@ def open_bag(path: str | Path, *, recover_truncated: bool = False) -> Iterator[B
             for conn, t_ns, raw in reader.messages(connections=conns):
                 yield conn.topic, conn.msgtype, t_ns, reader.deserialize(raw, conn.msgtype)
 
-        yield BagContents(path, topics, counts, notes, source)
+        yield BagContents(path, topics, counts, notes, source, latched)
     finally:
         reader.close()
 

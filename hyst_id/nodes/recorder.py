@@ -97,6 +97,19 @@ def _qos_for(infos: list) -> QoSProfile:
                                   else DurabilityPolicy.VOLATILE))
 
 
+def _offered(qos: QoSProfile) -> dict[str, Any]:
+    """A publisher's QoS as rmw values, for the bag's ``offered_qos_profiles``."""
+    def ns(duration: Any) -> int:
+        return int(getattr(duration, 'nanoseconds', 0) or 0)
+
+    return {'history': int(qos.history), 'depth': int(qos.depth),
+            'reliability': int(qos.reliability), 'durability': int(qos.durability),
+            'liveliness': int(qos.liveliness), 'deadline_ns': ns(qos.deadline),
+            'lifespan_ns': ns(qos.lifespan),
+            'liveliness_lease_duration_ns': ns(qos.liveliness_lease_duration),
+            'avoid_ros_namespace_conventions': bool(qos.avoid_ros_namespace_conventions)}
+
+
 class Recorder(HystNode):
     """Write the configured topics into an MCAP bag until shut down."""
 
@@ -144,7 +157,8 @@ class Recorder(HystNode):
             try:
                 cls = message_class(msgtype)
                 with self._lock:
-                    self._writer.add_topic(topic, msgtype)
+                    self._writer.add_topic(topic, msgtype, [_offered(i.qos_profile)
+                                                            for i in infos])
             except (ConfigError, ValueError) as exc:
                 self.get_logger().error(f'cannot record {topic}: {exc}')
                 self._wanted.remove(topic)

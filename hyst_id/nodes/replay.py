@@ -62,8 +62,8 @@ PARAMS = [
 ]
 
 
-def _qos(topic: str) -> QoSProfile:
-    latched = ('/' + topic.lstrip('/')).endswith('/' + IDENTIFIED_PARAMS_TOPIC)
+def _qos(topic: str, latched: bool = False) -> QoSProfile:
+    latched = latched or ('/' + topic.lstrip('/')).endswith('/' + IDENTIFIED_PARAMS_TOPIC)
     return QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1 if latched else 1000,
                       reliability=ReliabilityPolicy.RELIABLE,
                       durability=(DurabilityPolicy.TRANSIENT_LOCAL if latched
@@ -82,6 +82,7 @@ class Replay(HystNode):
         with open_bag(self.path, recover_truncated=self.p('recover_truncated')) as bag:
             available = dict(bag.topics)
             counts = dict(bag.counts)
+            latched = set(bag.latched)
             if selected and selected != ['*']:
                 bag.check_topics(selected)
                 available = {t: available[t] for t in selected}
@@ -94,7 +95,7 @@ class Replay(HystNode):
             except ConfigError as exc:
                 self.get_logger().warning(f'skipping {topic}: {exc}')
                 continue
-            self._pubs[topic] = self.create_publisher(cls, topic, _qos(topic))
+            self._pubs[topic] = self.create_publisher(cls, topic, _qos(topic, topic in latched))
         if not self._pubs:
             raise RecordingError(f'{self.path}: no playable topics')
         self.published = 0

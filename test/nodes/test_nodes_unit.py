@@ -40,7 +40,7 @@ from hyst_id.compensation.params_file import (  # noqa: E402
 from hyst_id.errors import ConfigError, RecordingError  # noqa: E402
 from hyst_id.identification import identify  # noqa: E402
 from hyst_id.identification.chains import chain_spec  # noqa: E402
-from hyst_id.io.bag import iter_bag_messages, write_recording_bag  # noqa: E402
+from hyst_id.io.bag import iter_bag_messages, open_bag, write_recording_bag  # noqa: E402
 from hyst_id.io.recording import Recording  # noqa: E402
 from hyst_id.live import pair_streams  # noqa: E402
 from hyst_id.nodes.actuator_driver import (  # noqa: E402
@@ -426,20 +426,28 @@ def test_excitation_publishes_the_profile_samples(ctx):
 
 
 def test_recorder_writes_a_readable_bag(ctx, tmp_path):
-    rec = _make(ctx, Recorder, parameter_overrides=[
+    rec = _make(ctx, Recorder, namespace='/valve1', parameter_overrides=[
         Parameter('output', value=str(tmp_path / 'bag')),
-        Parameter('topics', value=['/hyst_id/command', '/hyst_id/position'])])
-    talker = _make(ctx, Node, 'talker')
-    pub = talker.create_publisher(Float64, '/hyst_id/command', 100)
-    assert _spin_until(ctx, [rec, talker], lambda: '/hyst_id/command' in rec.subscribed)
+        Parameter('topics', value=['hyst_id/command', '/hyst_id/position', 'latched'])])
+    talker = _make(ctx, Node, 'talker', namespace='/valve1')
+    pub = talker.create_publisher(Float64, 'hyst_id/command', 100)
+    talker.create_publisher(Float64, 'latched', LATCHED_QOS).publish(Float64(data=1.0))
+    # relative names are recorded in the recorder's namespace, absolute ones as given
+    assert rec._wanted == ['/valve1/hyst_id/command', '/hyst_id/position', '/valve1/latched']
+    assert _spin_until(ctx, [rec, talker], lambda: {'/valve1/hyst_id/command',
+                                                    '/valve1/latched'} <= set(rec.subscribed))
     assert _spin_until(ctx, [rec, talker], lambda: pub.get_subscription_count() > 0)
     for k in range(20):
         pub.publish(Float64(data=float(k)))
-    assert _spin_until(ctx, [rec, talker], lambda: rec.counts['/hyst_id/command'] == 20)
+    assert _spin_until(ctx, [rec, talker],
+                       lambda: rec.counts['/valve1/hyst_id/command'] == 20)
     rec.close()
-    rows = list(iter_bag_messages(tmp_path / 'bag'))
+    rows = list(iter_bag_messages(tmp_path / 'bag', topics=['/valve1/hyst_id/command']))
     assert [m.data for _, _, _, m in rows] == [float(k) for k in range(20)]
-    assert (tmp_path / 'bag' / 'metadata.yaml').exists()
+    meta = (tmp_path / 'bag' / 'metadata.yaml').read_text()
+    assert 'ros_distro: rosbags' not in meta and 'offered_qos_profiles' in meta
+    with open_bag(tmp_path / 'bag') as bag:             # the latched topic replays latched
+        assert bag.latched == {'/valve1/latched'}
     with pytest.raises(RecordingError, match='cannot create bag'):
         Recorder(context=ctx[0], parameter_overrides=[
             Parameter('output', value=str(tmp_path / 'bag'))])
