@@ -86,6 +86,9 @@ def at_path(tokens: Sequence[str | int], value: float) -> Any:
     if not tokens:
         return value
     head, rest = tokens[0], at_path(tokens[1:], value)
+    if isinstance(head, str) and type(head) is not str:          # topics.NamedIndex
+        raise ConfigError(f'a field addressed by name ([{head}]) can be read, not written: '
+                          'give the index, e.g. position[0]')
     if isinstance(head, int):
         return [None] * head + [rest]
     return {head: rest}

@@ -31,7 +31,7 @@ from hyst_id.errors import ConfigError
 from hyst_id.io.params_file import read_yaml
 from hyst_id.io.recording import CHANNELS
 
-__all__ = ['TOPIC_FILE_KEYS', 'TopicConfig', 'get_field', 'load_topic_config',
+__all__ = ['NamedIndex', 'TOPIC_FILE_KEYS', 'TopicConfig', 'get_field', 'load_topic_config',
            'parse_field_path']
 
 #: Per channel: topic, message type, field path, unit.
@@ -46,11 +46,24 @@ _KEYS = frozenset([f'command_{s}' for s in _SUFFIXES] + ['stamp_source']
                   + [f'{ch}_{s}' for ch in CHANNELS for s in _SUFFIXES])
 #: Every key ``params/topics.yaml`` may hold (shared by all nodes through ``/**``).
 TOPIC_FILE_KEYS = _KEYS
-_FIELD_RE = re.compile(r'[A-Za-z_]\w*(\[\d+\])*(\.[A-Za-z_]\w*(\[\d+\])*)*')
+_INDEX = r'\[(\d+|[A-Za-z_][\w.-]*)\]'
+_FIELD_RE = re.compile(rf'[A-Za-z_]\w*({_INDEX})*(\.[A-Za-z_]\w*({_INDEX})*)*')
+
+
+class NamedIndex(str):
+    """A field-path index given by name: ``position[valve]`` is ``position[name.index('valve')]``.
+
+    The label is looked up in the ``name`` array of the message that holds
+    the indexed field (``sensor_msgs/JointState``'s joint names), so a
+    recording reads the right joint whatever the order the driver publishes.
+    """
 
 
 def parse_field_path(path: str) -> tuple[str | int, ...]:
     """Split a field path such as ``'position[0]'`` or ``'a.b[2].c'`` into tokens.
+
+    An index may be a name, ``position[valve]`` (a :class:`NamedIndex`:
+    the entry whose ``name`` is ``valve``).
 
     Raises
     ------
@@ -58,17 +71,36 @@ def parse_field_path(path: str) -> tuple[str | int, ...]:
         The path is not dotted attribute names with optional ``[i]`` indices.
     """
     if not isinstance(path, str) or not _FIELD_RE.fullmatch(path):
-        raise ConfigError(f'bad field path {path!r}: expected names with optional [i] indices, '
-                          f'e.g. position[0] or header.stamp.sec')
-    return tuple(int(tok[1:-1]) if tok.startswith('[') else tok
-                 for tok in re.findall(r'\[\d+\]|[A-Za-z_]\w*', path))
+        raise ConfigError(f'bad field path {path!r}: expected names with optional [i] or '
+                          f'[name] indices, e.g. position[0], position[valve] or '
+                          f'header.stamp.sec')
+    out: list[str | int] = []
+    for tok in re.findall(r'\[[^\]]+\]|[A-Za-z_]\w*', path):
+        if tok.startswith('['):
+            label = tok[1:-1]
+            out.append(int(label) if label.isdigit() else NamedIndex(label))
+        else:
+            out.append(tok)
+    return tuple(out)
 
 
 def get_field(msg: Any, tokens: Sequence[str | int]) -> Any:
-    """Follow parsed field-path ``tokens`` into a message (AttributeError/IndexError if absent)."""
-    value = msg
+    """Follow parsed field-path ``tokens`` into a message.
+
+    Raises AttributeError / IndexError when a field or index is absent, and
+    KeyError when a :class:`NamedIndex` is not among the holder's ``name`` entries.
+    """
+    value, holder = msg, msg
     for tok in tokens:
-        value = value[tok] if isinstance(tok, int) else getattr(value, tok)
+        if isinstance(tok, NamedIndex):
+            names = list(getattr(holder, 'name'))
+            if tok not in names:
+                raise KeyError(f'no entry named {str(tok)!r} (names: {names})')
+            value = value[names.index(tok)]
+        elif isinstance(tok, int):
+            value = value[tok]
+        else:
+            holder, value = value, getattr(value, tok)
     return value
 
 

@@ -196,6 +196,14 @@ class Compensator(HystNode):
                     f'({values["max_command"]:g})')
         if values['output_sign'] not in (1.0, -1.0):
             return f'output_sign must be 1.0 or -1.0; got {values["output_sign"]!r}'
+        er = values['er_percent']
+        if 'er_percent' in changed and not (math.isnan(er) or 0.0 <= er < math.inf):
+            return f'er_percent must be >= 0 (or .nan); got {er!r}'
+        if 'channel' in changed and getattr(self, '_comp', None) is not None \
+                and self._comp.model is not None \
+                and not set(compensator_names(values['family'])) <= changed:
+            return (f'channel changes only together with a new parameter set (the set in use '
+                    f'was identified on {self.p("channel")!r})')
         if changed & _MODEL_KEYS:
             names = compensator_names(values['family'])
             inf = [n for n in names if math.isinf(values[n])]

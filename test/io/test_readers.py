@@ -290,6 +290,29 @@ def test_empty_position_array(tmp_path: Path) -> None:
     assert 'position[0]' in msg
 
 
+def test_joint_read_by_name_in_any_order(tmp_path: Path) -> None:
+    rec = _rec(n=400)
+    with BagWriter(tmp_path / 'bag') as bag:
+        bag.add_topic('/hyst_id/command', 'std_msgs/msg/Float64')
+        bag.add_topic('/hyst_id/position', 'sensor_msgs/msg/JointState')
+        for k in range(rec.n_samples):
+            t_ns = T0 + int(rec.t_s[k] * 1e9)
+            bag.write('/hyst_id/command', t_ns, {'data': float(rec.command[k])})
+            names = ['arm', 'valve'] if k % 2 else ['valve', 'arm']   # the driver's order varies
+            pos = [-1.0, float(rec.measurement[k])] if k % 2 else [float(rec.measurement[k]), -1.0]
+            bag.write('/hyst_id/position', t_ns + 1000,
+                      {'header': {'stamp': t_ns + 1000}, 'name': names, 'position': pos})
+    got = read_recording(tmp_path / 'bag', 'position',
+                         topics={'position_field': 'position[valve]'})
+    np.testing.assert_allclose(got.measurement, rec.measurement)
+    msg = _raises(RecordingError, read_recording, tmp_path / 'bag', 'position',
+                  topics={'position_field': 'position[gripper]'})
+    assert "no entry named 'gripper'" in msg
+    with pytest.raises(ConfigError, match='can be read, not written'):
+        write_recording_bag(tmp_path / 'out', rec, TopicConfig.for_channel(
+            'position', {'position_field': 'position[valve]'}))
+
+
 def test_empty_topic(tmp_path: Path) -> None:
     with BagWriter(tmp_path / 'bag') as bag:
         bag.add_topic('/hyst_id/command', 'std_msgs/msg/Float64')
@@ -489,7 +512,7 @@ def test_topic_config_layouts(tmp_path: Path) -> None:
 def test_topic_config_errors(tmp_path: Path) -> None:
     bad_key = _write(tmp_path / 'a.yaml', 'topics:\n  comand_topic: /c\n')
     assert 'comand_topic' in _raises(ConfigError, load_topic_config, bad_key, 'flow')
-    bad_field = _write(tmp_path / 'b.yaml', 'topics:\n  flow_field: "data[x]"\n')
+    bad_field = _write(tmp_path / 'b.yaml', 'topics:\n  flow_field: "data[-1]"\n')
     _raises(ConfigError, load_topic_config, bad_field, 'flow')
     _raises(ConfigError, load_topic_config, _write(tmp_path / 'c.yaml', 'topics: [1\n'), 'flow')
     _raises(ConfigError, load_topic_config, tmp_path / 'missing.yaml', 'flow')

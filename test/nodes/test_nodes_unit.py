@@ -128,6 +128,7 @@ def test_defaults_match_the_params_files():
     (Compensator, {'channel': 'torque'}, 'one of'),
     (Compensator, {'topics.command_topic': '/x'}, 'read-only'),
     (Compensator, {'output_sign': 0.5}, 'output_sign'),
+    (Compensator, {'er_percent': -5.0}, 'er_percent'),
     (Compensator, {**PAPER, 'c_l': 0.9}, 'not proper'),
     (Compensator, {**PAPER, 'm_t': 2.0}, 'm_t'),
     (Compensator, {**PAPER, 'm_l': math.inf}, 'finite'),
@@ -150,6 +151,16 @@ def test_bad_parameters_are_rejected_with_a_reason(ctx, cls, values, needle):
     for key in values:
         a, b = node.p(key), before[key]
         assert a == b or (isinstance(a, float) and math.isnan(a) and math.isnan(b))
+
+
+def test_channel_changes_only_with_a_new_set(ctx):
+    comp = _make(ctx, Compensator, parameter_overrides=[
+        Parameter(k, value=v) for k, v in PAPER.items()])
+    result = _set(comp, channel='pressure')
+    assert not result.successful and 'together with a new parameter set' in result.reason
+    assert comp.p('channel') == 'position'
+    assert _set(comp, channel='pressure', **{**PAPER, 'c_br': 0.3}).successful
+    assert comp.p('channel') == 'pressure' and comp.p('c_br') == 0.3
 
 
 def test_bad_params_file_is_a_one_line_config_error(ros_domain, tmp_path):
