@@ -24,12 +24,8 @@ noise floor.
 
 from __future__ import annotations
 
-from concurrent.futures import ProcessPoolExecutor
-from concurrent.futures.process import BrokenProcessPool
 from dataclasses import replace
-import multiprocessing
 import os
-import threading
 from typing import Any, Callable
 
 import numpy as np
@@ -49,6 +45,7 @@ from hyst_id.identification.quality import assess
 from hyst_id.identification.refine import refine
 from hyst_id.identification.result import Identification, IdentifySettings, SeedRun
 from hyst_id.identification.starts import data_starts
+from hyst_id.identification.workers import map_in_processes
 from hyst_id.io.recording import Recording, roundoff_probe, validate_recording
 from hyst_id.signals.noise import noise_floor_percent
 from hyst_id.solvers.gaass import GaassSolver
@@ -275,18 +272,6 @@ def _distinct_best(pop: np.ndarray, fun: np.ndarray, count: int) -> list[np.ndar
     return chosen
 
 
-def _mp_context():
-    """Fork where it is safe (no other threads, POSIX), spawn otherwise.
-
-    Fork needs no ``if __name__ == '__main__'`` guard in user scripts and
-    reuses the compiled numba kernels; with threads running (a ROS
-    executor) only spawn is safe.
-    """
-    if 'fork' in multiprocessing.get_all_start_methods() and threading.active_count() == 1:
-        return multiprocessing.get_context('fork')
-    return multiprocessing.get_context('spawn')
-
-
 #: Restarts may stop for lack of gain only above this multiple of the noise floor.
 _STALL_FLOOR_FACTOR = 1.5
 
@@ -299,8 +284,8 @@ def _n_workers(settings: IdentifySettings) -> int:
 def identify(recording: Recording, *, spec: ChainSpec | None = None,
              settings: IdentifySettings | None = None,
              progress: Callable[[int, int, SeedRun], None] | None = None,
-             on_generation: Callable[[int, int, int, float], Any] | None = None
-             ) -> Identification:
+             on_generation: Callable[[int, int, int, float], Any] | None = None,
+             should_stop: Callable[[], bool] | None = None) -> Identification:
     """Identify the chain of ``recording.channel`` from a recording.
 
     Parameters
@@ -319,6 +304,11 @@ def identify(recording: Recording, *, spec: ChainSpec | None = None,
         Called as ``on_generation(seed, restart, generation, er_percent)``
         after every GAASS generation, when the seeds run in this process
         (``workers == 1``; worker processes report per seed only).
+    should_stop : callable, optional
+        With worker processes: looked at every 0.2 s; when true the
+        workers are ended at once and
+        :class:`~hyst_id.identification.workers.WorkersStopped` is raised
+        (with ``workers == 1`` raise from ``on_generation`` instead).
 
     Returns
     -------
@@ -356,19 +346,17 @@ def identify(recording: Recording, *, spec: ChainSpec | None = None,
             if progress:
                 progress(len(runs), len(settings.seeds), runs[-1])
     else:
-        # Limit BLAS threads in the parent too: forked children inherit its pools.
-        with threadpool_limits(limits=1), ProcessPoolExecutor(
-                max_workers=n_workers, mp_context=_mp_context()) as pool:
-            futures = [pool.submit(run_seed, *args, seed, floor, None, given[seed],
-                                   alternates[seed])
-                       for seed in settings.seeds]
-            try:
-                for fut in futures:
-                    runs.append(fut.result())
-                    if progress:
-                        progress(len(runs), len(settings.seeds), runs[-1])
-            except BrokenProcessPool as exc:
-                raise IdentificationError(f'a worker process died: {exc}') from None
+        done: list[SeedRun] = []
+
+        def on_result(run: SeedRun) -> None:
+            done.append(run)
+            if progress:
+                progress(len(done), len(settings.seeds), run)
+
+        runs = map_in_processes(
+            run_seed, [(*args, seed, floor, None, given[seed], alternates[seed])
+                       for seed in settings.seeds], n_workers,
+            on_result=on_result, should_stop=should_stop)
     best = min(runs, key=lambda r: r.fun)
     if settings.refine and settings.global_evals > 0 \
             and best.er_percent > settings.global_factor * floor:

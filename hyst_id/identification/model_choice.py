@@ -113,7 +113,8 @@ def choose_family(recording: Recording, families: Sequence[str] = AUTO_FAMILIES,
                   tie_ratio: float = 1.02,
                   progress: Callable[[str, str], None] | None = None,
                   seed_progress: Callable | None = None,
-                  on_generation: Callable | None = None) -> ModelChoice:
+                  on_generation: Callable | None = None,
+                  should_stop: Callable | None = None) -> ModelChoice:
     """Identify each family on the first part, keep the one that predicts the rest best.
 
     Parameters
@@ -130,8 +131,9 @@ def choose_family(recording: Recording, families: Sequence[str] = AUTO_FAMILIES,
         A later family must beat the best earlier one by more than this factor.
     progress : callable, optional
         Called as ``progress(family, stage)`` with stage ``'train'`` or ``'final'``.
-    seed_progress, on_generation : callable, optional
-        Passed to every :func:`identify` as its ``progress`` and ``on_generation``.
+    seed_progress, on_generation, should_stop : callable, optional
+        Passed to every :func:`identify` as its ``progress``, ``on_generation``
+        and ``should_stop``.
 
     Returns
     -------
@@ -165,7 +167,8 @@ def choose_family(recording: Recording, families: Sequence[str] = AUTO_FAMILIES,
         if progress:
             progress(fam, 'train')
         ident = identify(train, spec=domains_from_data(train, family=fam), settings=settings,
-                         progress=seed_progress, on_generation=on_generation)
+                         progress=seed_progress, on_generation=on_generation,
+                         should_stop=should_stop)
         tr, ho = holdout_error(ident, rec, train.n_samples)
         scores.append(FamilyScore(fam, tr, ho, ident))
     best = scores[0]
@@ -175,7 +178,8 @@ def choose_family(recording: Recording, families: Sequence[str] = AUTO_FAMILIES,
     if progress:
         progress(best.family, 'final')
     final = identify(rec, spec=domains_from_data(rec, family=best.family), settings=settings,
-                     progress=seed_progress, on_generation=on_generation)
+                     progress=seed_progress, on_generation=on_generation,
+                     should_stop=should_stop)
     return ModelChoice(best.family, tuple(scores), final, fit_share)
 
 

@@ -78,7 +78,10 @@ class BackgroundJob:
         except JobCancelled:
             self.cancelled = True
         except HystIdError as exc:
-            self.error = str(exc)
+            if self._cancel.is_set():       # e.g. WorkersStopped: the workers were ended
+                self.cancelled = True
+            else:
+                self.error = str(exc)
         except Exception as exc:  # noqa: BLE001 - reported by the caller, never a traceback
             self.error = f'{type(exc).__name__}: {exc}'
 
@@ -118,8 +121,8 @@ class IdentificationJob(BackgroundJob):
     The same function as ``hyst-id identify``, so the same settings and
     seeds give the same result. ``workers == 1`` runs the seeds one after
     the other in the thread (a cancel stops it within a generation);
-    otherwise ``identify`` runs them in worker processes and the thread only
-    waits (a cancel takes effect when they are done). :meth:`progress` is
+    otherwise ``identify`` runs them in worker processes, which a cancel
+    ends within 0.2 s. :meth:`progress` is
     safe to call from another thread at any time; with ``workers == 1`` it
     also gives the running seed's GAASS generation.
 
@@ -146,10 +149,12 @@ class IdentificationJob(BackgroundJob):
         if self.families:
             self.choice = choose_family(self.rec, self.families, settings=self.settings,
                                         seed_progress=self._progress,
-                                        on_generation=self._generation)
+                                        on_generation=self._generation,
+                                        should_stop=self._cancel.is_set)
             return self.choice.identification
         return identify(self.rec, spec=self.spec, settings=self.settings,
-                        progress=self._progress, on_generation=self._generation)
+                        progress=self._progress, on_generation=self._generation,
+                        should_stop=self._cancel.is_set)
 
     def _progress(self, done: int, total: int, run: SeedRun) -> None:
         self.runs = self.runs + [run]

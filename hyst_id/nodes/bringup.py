@@ -45,6 +45,7 @@ from __future__ import annotations
 
 import datetime
 import math
+import signal
 import sys
 import time
 from typing import Any
@@ -69,12 +70,15 @@ from hyst_id.nodes.recorder import Recorder
 from hyst_id.nodes.support import (
     COMMAND_QOS,
     DESIRED_TOPIC,
+    exit_code_after,
     HystNode,
     init_ros,
     message_class,
     Param,
     SENSOR_QOS,
+    spin_until_stopped,
     stamp_ns,
+    stop_signals,
 )
 
 __all__ = ['Bringup', 'Lockstep', 'PARAMS', 'control_error_percent', 'main']
@@ -151,19 +155,20 @@ class Bringup(HystNode):
     """Create the graph's nodes and sequence the experiment."""
 
     def __init__(self, **kwargs: Any) -> None:
-        super().__init__('bringup', PARAMS, **kwargs)
+        super().__init__('bringup', PARAMS, report_unknown=False, **kwargs)
         v = self.param_values()
         ts, ch = v['time_scale'], v['channel']
         bag = v['bag'] or datetime.datetime.now().strftime('hyst_id_bringup_%Y_%m_%d-%H_%M_%S')
         self.done = Future()
         self.exit_code = 1
         self.results: dict[str, float] = {}
-        self.actuator = ActuatorDriver(defaults={'time_scale': ts})
-        self.pipeline = PipelineSim(defaults={'time_scale': ts})
-        self.recorder = Recorder(defaults={'output': bag})
+        self.actuator = ActuatorDriver(defaults={'time_scale': ts}, report_unknown=False)
+        self.pipeline = PipelineSim(defaults={'time_scale': ts}, report_unknown=False)
+        self.recorder = Recorder(defaults={'output': bag}, report_unknown=False)
         self.identifier = Identifier(defaults={'channel': ch, 'end_of_run_timeout_s': 0.0,
-                                               'recover_on_start': False})
-        self.compensator = Compensator(defaults={'channel': ch})
+                                               'recover_on_start': False},
+                                     report_unknown=False)
+        self.compensator = Compensator(defaults={'channel': ch}, report_unknown=False)
         k, b = self._calibration()
         comp_profile = {'profile': 'eq25'}
         if (k, b) != (1.0, 0.0):   # desired value in the sensor's units
@@ -172,17 +177,25 @@ class Bringup(HystNode):
         self.excite_identify = Excitation(
             'excitation_identify', defaults={**common, 'profile': 'eq24',
                                              'duration_s': v['identify_duration_s'],
-                                             'sample_period_s': v['identify_sample_period_s']})
+                                             'sample_period_s': v['identify_sample_period_s']},
+            report_unknown=False)
         comp = {**common, 'duration_s': v['compensate_duration_s'],
                 'sample_period_s': v['compensate_sample_period_s']}
         self.excite_plain = Excitation('excitation_uncompensated',
-                                       defaults={**comp, 'profile': 'eq25'})
+                                       defaults={**comp, 'profile': 'eq25'},
+                                       report_unknown=False)
         self.excite_comp = Excitation('excitation_compensated',
                                       defaults={**comp, **comp_profile,
-                                                'topics.output_topic': DESIRED_TOPIC})
+                                                'topics.output_topic': DESIRED_TOPIC},
+                                      report_unknown=False)
         self.nodes = [self, self.actuator, self.pipeline, self.recorder, self.identifier,
                       self.compensator, self.excite_identify, self.excite_plain,
                       self.excite_comp]
+        # -p arguments reach every node of the process: a name is unknown only when no
+        # node of the graph declares it
+        declared = {n for node in self.nodes for n in node._param_table}
+        for node in self.nodes:
+            node.report_unknown_parameters(declared)
         self._k, self._b = k, b
         self.lockstep = Lockstep(v['lockstep_timeout_s'])
         for exc in (self.excite_identify, self.excite_plain, self.excite_comp):
@@ -345,24 +358,28 @@ def main(args: list[str] | None = None) -> int:
         return 2
     node = None
     code = 1
-    try:
-        node = Bringup()
-        executor = MultiThreadedExecutor(num_threads=4)
-        for n in node.nodes:
-            executor.add_node(n)
-        executor.spin_until_future_complete(node.done)
-        code = node.exit_code
-    except (KeyboardInterrupt, ExternalShutdownException):
-        code = 130
-    except HystIdError as exc:
-        rclpy.logging.get_logger('bringup').error(str(exc))
-        code = 2
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
+    with stop_signals() as state:
+        try:
+            node = Bringup()
+            executor = MultiThreadedExecutor(num_threads=4)
+            for n in node.nodes:
+                executor.add_node(n)
+            spin_until_stopped(executor, state, node.done.done)
+            if node.done.done():
+                code = node.exit_code
+            elif state['signal']:
+                code = 0             # a requested stop (130 after Ctrl-C, below)
+        except (KeyboardInterrupt, ExternalShutdownException):
+            state['signal'] = state['signal'] or signal.SIGINT
+        except HystIdError as exc:
+            rclpy.logging.get_logger('bringup').error(str(exc))
+            code = 2
+        finally:
+            if node is not None:
+                node.destroy_node()
+            rclpy.try_shutdown()
     sys.stdout.flush()
-    return code
+    return exit_code_after(state, code)
 
 
 if __name__ == '__main__':

@@ -495,9 +495,11 @@ class Identifier(HystNode):
         """Stop workers, then the node."""
         if hasattr(self, '_warm'):    # also called on a node whose __init__ failed
             self._warm.shutdown(wait=False, cancel_futures=True)
-            for job in (self.job, self.diag_job):
-                if job is not None:
-                    job.cancel()
+            jobs = [j for j in (self.job, self.diag_job, *self._cancelled) if j is not None]
+            for job in jobs:
+                job.cancel()
+            for job in jobs:        # worker processes end within 0.2 s of a cancel
+                job.wait(2.0)
         super().destroy_node()
 
 

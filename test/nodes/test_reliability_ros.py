@@ -21,7 +21,7 @@ test publishes and listens in-process.
   and holds every message sent up to the loss window before the kill
   (the pending chunk: ``min(chunk_span_s, chunk_size / byte rate)``, plus a
   margin for delivery), without holes.
-* Recorder + SIGINT / SIGTERM: exit 0, ``metadata.yaml`` written, the bag
+* Recorder + SIGINT / SIGTERM: exit 130 / 0, ``metadata.yaml`` written, the bag
   reads without recovery and holds every message sent.
 * Compensator at 1 kHz for 5 s with valid and invalid parameter updates
   (``bench/compensator_load.py``, whose full run is 60 s): nothing lost, no
@@ -162,7 +162,7 @@ def test_interrupted_recorder_writes_a_complete_bag(talker, tmp_path, sig):
         talker.run(1.0)
         time.sleep(0.5)                       # let the last messages arrive
         proc.send_signal(sig)
-        assert proc.wait(15) == 0, log.read_text()
+        assert proc.wait(15) == (130 if sig == signal.SIGINT else 0), log.read_text()
     finally:
         if proc.poll() is None:
             proc.kill()
@@ -193,4 +193,4 @@ def test_compensator_at_1khz_with_updates_loses_nothing(ros_domain, tmp_path):
     assert len(r['reasons']) == 4 and all(': ' in why for why in r['reasons'])
     assert r['generations'] == list(range(r['applied'] + 1))
     assert r['shadow_mismatches'] == 0
-    assert r['compensator_exit'] == 0 and 'Traceback' not in log
+    assert r['compensator_exit'] == 130 and 'Traceback' not in log

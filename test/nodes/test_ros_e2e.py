@@ -175,7 +175,7 @@ def test_live_pipeline_then_replay_agrees_with_cli(ros_domain, tmp_path):
                     '-p', 'shutdown_when_done:=true')
         assert graph.wait_exit('excite_eq24', 60.0) == 0, graph.log('excite_eq24')
         time.sleep(0.5)
-        assert graph.interrupt('recorder') == 0, graph.log('recorder')
+        assert graph.interrupt('recorder') == 130, graph.log('recorder')
         assert (bag / 'metadata.yaml').exists(), graph.log('recorder')
         assert 'Traceback' not in graph.log('recorder')
 
@@ -184,7 +184,7 @@ def test_live_pipeline_then_replay_agrees_with_cli(ros_domain, tmp_path):
               f'{live["n_samples"]} samples')
         assert live['n_samples'] >= 595 and live['er_percent'] < 1.0
         graph.wait_log('compensator', 'applied parameter set', 20.0)
-        assert graph.interrupt('identifier') == 0, graph.log('identifier')
+        assert graph.interrupt('identifier') == 130, graph.log('identifier')
         assert (tmp_path / 'live.yaml').exists()
 
         # -- Eq. 25 without, then with the compensator (60 s at 0.5 s, 10x)
@@ -208,7 +208,7 @@ def test_live_pipeline_then_replay_agrees_with_cli(ros_domain, tmp_path):
         assert n_plain >= 115 and n_comp >= 115
         assert comp < 0.5 * plain
         for name in ('actuator_driver', 'compensator'):
-            assert graph.interrupt(name) == 0, graph.log(name)
+            assert graph.interrupt(name) == 130, graph.log(name)
             assert 'Traceback' not in graph.log(name)
 
         # -- replay the bag into a fresh identifier; compare with the CLI
@@ -241,7 +241,7 @@ def test_live_pipeline_then_replay_agrees_with_cli(ros_domain, tmp_path):
         for name, value in ref['params'].items():
             assert replayed['params'][name] == pytest.approx(value, rel=1e-9, abs=1e-12), name
         assert replayed['er_percent'] == pytest.approx(ref['er_percent'], rel=1e-9)
-        assert graph.interrupt('identifier_replay') == 0
+        assert graph.interrupt('identifier_replay') == 130
         print(f'end-to-end test: {time.monotonic() - t_start:.1f} s')
     finally:
         obs.close()

@@ -31,19 +31,24 @@ from hyst_id.nodes.support.qos import (
 )
 from hyst_id.nodes.support.ros import (
                                        diagnostic_array,
+                                       exit_code_after,
+                                       EXIT_SIGINT,
                                        init_ros,
                                        message_class,
                                        resolved,
                                        source_time_ns,
                                        spin_in_background,
                                        spin_node,
+                                       spin_until_stopped,
                                        stamp_ns,
+                                       stop_signals,
                                        try_publish,
                                        type_mismatches,
 )
 
 __all__ = [
-    'COMMAND_QOS', 'DESIRED_TOPIC', 'DIAGNOSTICS_QOS', 'DIAGNOSTICS_TOPIC', 'HystNode',
+    'COMMAND_QOS', 'DESIRED_TOPIC', 'DIAGNOSTICS_QOS', 'DIAGNOSTICS_TOPIC', 'EXIT_SIGINT',
+    'HystNode', 'exit_code_after', 'spin_until_stopped', 'stop_signals',
     'IDENTIFIED_PARAMS_TOPIC', 'LATCHED_QOS', 'Param', 'ParameterPusher', 'SENSOR_QOS',
     'TOPIC_KEYS', 'diagnostic_array', 'field_params', 'init_ros', 'message_class',
     'resolved', 'source_time_ns', 'spin_in_background', 'spin_node', 'stamp_ns', 'topic_params',

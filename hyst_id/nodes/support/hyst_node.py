@@ -84,7 +84,8 @@ class HystNode(Node):
     """
 
     def __init__(self, node_name: str, params: Sequence[Param],
-                 defaults: Mapping[str, Any] | None = None, **kwargs: Any) -> None:
+                 defaults: Mapping[str, Any] | None = None, report_unknown: bool = True,
+                 **kwargs: Any) -> None:
         super().__init__(node_name, **kwargs)
         self._param_table = {p.name: p for p in params}
         self._diag_pub = None
@@ -111,15 +112,28 @@ class HystNode(Node):
             raise ConfigError(f'invalid parameters: {reason}')
         self.add_on_set_parameters_callback(self._on_set_parameters)
         #: Params-file / ``-p`` names that match no parameter (ignored).
+        self.unknown_parameters: list[str] = []
+        if report_unknown:
+            self.report_unknown_parameters()
+
+    def report_unknown_parameters(self, declared: Iterable[str] | None = None) -> list[str]:
+        """Find, log (ERROR) and keep reporting overrides no parameter matches.
+
+        ``declared`` defaults to this node's parameters; a process running
+        several nodes (``bringup``), whose ``-p`` arguments reach every node,
+        passes the names all of them declare.
+        """
+        names = set(self._param_table) | set(declared or ())
         self.unknown_parameters = unknown_overrides(
-            getattr(self, '_parameter_overrides', {}), self._param_table)
-        if self.unknown_parameters:
+            getattr(self, '_parameter_overrides', {}), names)
+        if self.unknown_parameters and not hasattr(self, '_unknown_message'):
             self._unknown_message = (
                 f'unknown parameter(s) ignored: {", ".join(self.unknown_parameters)} (a typo, '
-                f'or a key of another node?); {node_name} declares: '
+                f'or a key of another node?); {self.get_name()} declares: '
                 + ', '.join(sorted(n for n in self._param_table if not n.startswith('topics.'))))
             self.get_logger().error(self._unknown_message)
             self.create_timer(1.0, self._report_unknown)
+        return self.unknown_parameters
 
     # --------------------------------------------------------------- params
     def param_values(self) -> dict[str, Any]:

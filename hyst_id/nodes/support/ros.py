@@ -21,22 +21,25 @@ and one-line errors.
 
 from __future__ import annotations
 
+from contextlib import contextmanager
 import importlib
+import signal
 import sys
 import threading
-from typing import Any, Callable, Mapping
+from typing import Any, Callable, Iterator, Mapping
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 import rclpy
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.node import Node
+from rclpy.signals import SignalHandlerOptions
 
 from hyst_id.errors import ConfigError, HystIdError
 
-__all__ = ['diagnostic_array', 'first_line', 'init_ros', 'message_class', 'resolved',
-           'source_time_ns', 'spin_in_background', 'spin_node', 'stamp_ns', 'try_publish',
-           'type_mismatches']
+__all__ = ['EXIT_SIGINT', 'diagnostic_array', 'exit_code_after', 'first_line', 'init_ros',
+           'message_class', 'resolved', 'source_time_ns', 'spin_in_background', 'spin_node',
+           'spin_until_stopped', 'stamp_ns', 'stop_signals', 'try_publish', 'type_mismatches']
 
 _RCLError = _rclpy.RCLError
 
@@ -58,7 +61,9 @@ def message_class(type_name: str) -> type:
 def init_ros(args: list[str] | None, name: str) -> bool:
     """``rclpy.init``; on bad command-line arguments print one line and return False."""
     try:
-        rclpy.init(args=args)
+        # our own SIGINT/SIGTERM handlers (stop_signals) end the spin loop; rclpy's would
+        # shut the context down under a running callback
+        rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
     except Exception as exc:  # noqa: BLE001 - rcl's RCLError for a malformed --ros-args
         print(f'{name}: error: {first_line(exc)}', file=sys.stderr)
         return False
@@ -86,45 +91,91 @@ def source_time_ns(node: Node, info: Mapping[str, Any]) -> int:
         info.get('received_timestamp') or 0) or node.get_clock().now().nanoseconds
 
 
+#: Longest wait of the spin loop between two looks at the stop flag [s].
+SPIN_PERIOD_S = 0.1
+#: Exit code after SIGINT (Ctrl-C), as a shell reports it; SIGTERM is a requested stop (0).
+EXIT_SIGINT = 130
+
+
+@contextmanager
+def stop_signals() -> Iterator[dict[str, int]]:
+    """SIGINT and SIGTERM only record themselves: ``{'signal': signum}`` (0 until one came).
+
+    The spin loop (:func:`spin_until_stopped`) looks at the flag every
+    :data:`SPIN_PERIOD_S`, so a stop is never lost in a wait (no timer, no
+    traffic) nor raised inside a callback; the previous handlers come back
+    on exit.
+    """
+    state = {'signal': 0}
+
+    def handler(signum: int, frame: Any) -> None:
+        state['signal'] = state['signal'] or signum
+
+    previous = {}
+    if threading.current_thread() is threading.main_thread():
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            previous[sig] = signal.signal(sig, handler)
+    try:
+        yield state
+    finally:
+        for sig, old in previous.items():
+            signal.signal(sig, old)
+
+
+def spin_until_stopped(executor: Any, state: Mapping[str, int],
+                       done: Callable[[], bool] = lambda: False) -> None:
+    """Spin in :data:`SPIN_PERIOD_S` slices until a signal, ``done()`` or a shutdown."""
+    while not state['signal'] and not done() and executor.context.ok():
+        executor.spin_once(timeout_sec=SPIN_PERIOD_S)
+
+
+def exit_code_after(state: Mapping[str, int], code: int) -> int:
+    """``code``, or :data:`EXIT_SIGINT` after Ctrl-C (a SIGTERM stop keeps ``code``)."""
+    return EXIT_SIGINT if state['signal'] == signal.SIGINT else code
+
+
 def spin_node(node_class: type, name: str, args: list[str] | None = None) -> int:
     """Init, spin and shut down one node: the body of every node's ``main()``.
 
-    The demo_nodes_py pattern: Ctrl-C and an external shutdown (SIGTERM) end
-    the spin quietly, also when they land while rclpy builds its executor or
-    wait set (an ``RCLError`` on a context already shut down); a
+    The demo_nodes_py pattern, with stops that cannot hang: SIGINT/SIGTERM
+    set a flag (:func:`stop_signals`) that the loop reads every 0.1 s, also
+    when they land while the node is being built; an ``RCLError`` from a
+    context shut down under the executor ends the spin quietly; a
     :class:`~hyst_id.errors.HystIdError` raised while the node is built (a bad
-    params file) is logged in one line with exit code 2;
-    the node is always destroyed and the context shut down. A node may set
-    ``exit_code`` (e.g. the replay when its bag is unreadable); it is returned.
+    params file) is logged in one line with exit code 2; the node is always
+    destroyed (its workers ended) and the context shut down. Exit code: the
+    node's ``exit_code`` (e.g. the replay when its bag is unreadable), else
+    0; 130 after Ctrl-C.
     """
     if not init_ros(args, name):
         return 2
     node = None
     code = 0
-    try:
-        # made before the node (the slow part), so a signal during construction cannot
-        # leave a half-built executor behind
-        executor = SingleThreadedExecutor()
-        node = node_class()
-        executor.add_node(node)
-        executor.spin()
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    except HystIdError as exc:
-        rclpy.logging.get_logger(name).error(str(exc))
-        code = 2
-    except _RCLError as exc:
-        # A SIGINT/SIGTERM that shuts the context down while the executor is being made
-        # or builds its wait set surfaces as RCLError, not as an external shutdown.
-        if rclpy.ok():
-            print(f'{name}: error: {first_line(exc)}', file=sys.stderr)
-            code = 1
-    finally:
-        if node is not None:
-            code = code or int(getattr(node, 'exit_code', 0) or 0)
-            node.destroy_node()
-        rclpy.try_shutdown()
-    return code
+    with stop_signals() as state:
+        try:
+            # made before the node (the slow part), so a signal during construction
+            # cannot leave a half-built executor behind
+            executor = SingleThreadedExecutor()
+            node = node_class()
+            executor.add_node(node)
+            spin_until_stopped(executor, state)
+        except (KeyboardInterrupt, ExternalShutdownException):
+            state['signal'] = state['signal'] or signal.SIGINT
+        except HystIdError as exc:
+            rclpy.logging.get_logger(name).error(str(exc))
+            code = 2
+        except _RCLError as exc:
+            # a context shut down while the executor builds its wait set surfaces as
+            # RCLError, not as an external shutdown
+            if rclpy.ok() and not state['signal']:
+                print(f'{name}: error: {first_line(exc)}', file=sys.stderr)
+                code = 1
+        finally:
+            if node is not None:
+                code = code or int(getattr(node, 'exit_code', 0) or 0)
+                node.destroy_node()
+            rclpy.try_shutdown()
+        return exit_code_after(state, code)
 
 
 def stamp_ns(stamp: Any) -> int:

@@ -1,0 +1,138 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""Seeds in worker processes that end when asked, and with their parent.
+
+:func:`map_in_processes` runs a function over argument tuples in a process
+pool and hands back the results in input order. It looks at ``should_stop``
+every :data:`POLL_S` and, when it holds (or anything goes wrong), ends the
+workers at once instead of waiting for the running tasks. Each worker
+ignores SIGINT (Ctrl-C is the parent's to handle) and, on Linux, is sent
+SIGTERM by the kernel when its parent dies (``PR_SET_PDEATHSIG``), so a
+parent killed outright leaves no worker behind.
+"""
+
+from __future__ import annotations
+
+from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
+import ctypes
+import multiprocessing
+import os
+import signal
+import sys
+import threading
+from typing import Any, Callable, Sequence
+
+from threadpoolctl import threadpool_limits
+
+from hyst_id.errors import IdentificationError
+
+__all__ = ['POLL_S', 'WorkersStopped', 'map_in_processes', 'mp_context']
+
+#: How often a stop request is looked at while workers run [s].
+POLL_S = 0.2
+_PR_SET_PDEATHSIG = 1
+
+
+class WorkersStopped(IdentificationError):
+    """The workers were ended because ``should_stop`` held."""
+
+
+def mp_context() -> Any:
+    """Fork where it is safe (no other threads, POSIX), spawn otherwise.
+
+    Fork needs no ``if __name__ == '__main__'`` guard in user scripts and
+    reuses the compiled numba kernels; with threads running (a ROS
+    executor) only spawn is safe.
+    """
+    if 'fork' in multiprocessing.get_all_start_methods() and threading.active_count() == 1:
+        return multiprocessing.get_context('fork')
+    return multiprocessing.get_context('spawn')
+
+
+def _worker_init(parent_pid: int) -> None:
+    """Leave Ctrl-C to the parent; die with it (Linux)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if sys.platform.startswith('linux'):
+        try:
+            libc = ctypes.CDLL(None, use_errno=True)
+            libc.prctl(_PR_SET_PDEATHSIG, signal.SIGTERM, 0, 0, 0)
+        except (OSError, AttributeError):  # pragma: no cover - exotic libc
+            pass
+    if os.getppid() != parent_pid:      # the parent died before prctl took effect
+        os._exit(1)
+
+
+def _end(pool: ProcessPoolExecutor) -> None:
+    """Stop ``pool`` now: drop queued tasks and terminate the running workers."""
+    processes = list(getattr(pool, '_processes', {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    for proc in processes:
+        if proc.is_alive():
+            proc.terminate()
+    for proc in processes:
+        proc.join(2.0)
+        if proc.is_alive():
+            proc.kill()
+
+
+def map_in_processes(fn: Callable[..., Any], arg_tuples: Sequence[tuple], n_workers: int, *,
+                     on_result: Callable[[Any], None] | None = None,
+                     should_stop: Callable[[], bool] | None = None) -> list[Any]:
+    """``[fn(*args) for args in arg_tuples]`` in ``n_workers`` processes, in input order.
+
+    Parameters
+    ----------
+    fn : callable
+        A module-level function (picklable).
+    arg_tuples : sequence of tuple
+        Its arguments, one tuple per task.
+    n_workers : int
+        Worker processes.
+    on_result : callable, optional
+        Called with each result as it completes (in completion order); an
+        exception it raises ends the workers and propagates.
+    should_stop : callable, optional
+        Looked at every :data:`POLL_S`; when it returns true the workers are
+        ended and :class:`WorkersStopped` is raised.
+
+    Raises
+    ------
+    IdentificationError
+        A worker process died.
+    """
+    # Limit BLAS threads in the parent too: forked children inherit its pools.
+    with threadpool_limits(limits=1):
+        pool = ProcessPoolExecutor(max_workers=n_workers, mp_context=mp_context(),
+                                   initializer=_worker_init, initargs=(os.getpid(),))
+        try:
+            futures: list[Future] = [pool.submit(fn, *args) for args in arg_tuples]
+            pending = set(futures)
+            while pending:
+                finished, pending = wait(pending, timeout=POLL_S, return_when=FIRST_COMPLETED)
+                for fut in finished:
+                    if on_result is not None:
+                        on_result(fut.result())
+                if should_stop is not None and should_stop():
+                    raise WorkersStopped('stopped on request; worker processes ended')
+            results = [f.result() for f in futures]
+        except BrokenProcessPool as exc:
+            _end(pool)
+            raise IdentificationError(f'a worker process died: {exc}') from None
+        except BaseException:
+            _end(pool)
+            raise
+        pool.shutdown(wait=True)
+        return results
