@@ -304,6 +304,22 @@ def _summary(results: list[dict], methods: tuple[str, ...]) -> str:
     worst = err[np.argmax(np.abs(err))]
     lines += ['', f'noise estimate vs the true noise: median {np.median(err):+.1%}, '
               f'within +-10 % in {np.mean(np.abs(err) <= 0.1):.0%}, worst {worst:+.1%}']
+    ours = [r for r in results if 'identify' in r]
+    lines.append('identify within 1.1 x per channel: ' + ', '.join(
+        f'{ch} {sum(r["identify"][0] <= 1.1 for r in rs)}/{len(rs)}'
+        for ch in ('position', 'pressure', 'flow')
+        for rs in [[r for r in ours if r['note'].startswith(ch)]] if rs))
+    others = [m for m in methods if m != 'identify']
+    for m in others:
+        both = sum(min(r['identify'][0], r[m][0]) <= 1.1 for r in ours if m in r)
+        lines.append(f'the better of identify and {m} within 1.1 x: {both}/{len(ours)}')
+    misses = sorted((r for r in ours if r['identify'][0] > 1.1),
+                    key=lambda r: -r['identify'][0])
+    if misses:
+        lines += ['', f'identify above 1.1 x ({len(misses)}):']
+        lines += [f'  #{r["index"]}: {r["identify"][0]:.3f} x'
+                  + ''.join(f', {m} {r[m][0]:.3f} x' for m in others if m in r)
+                  + f' ({r["note"]})' for r in misses]
     return '\n'.join(lines)
 
 
