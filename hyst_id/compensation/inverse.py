@@ -161,6 +161,10 @@ class Compensator:
     def __init__(self, model: InverseModel | None, limits: CommandLimits | None = None,
                  v0: float = 0.0) -> None:
         self.limits = limits or CommandLimits()
+        #: True: pass the desired value through (within the limits) while the model
+        #: state keeps following the commands sent, so that ending the bypass resumes
+        #: from the actuator's real state.
+        self.bypass = False
         self._active: tuple[InverseModel | None, HysteresisInverse | None] = (model, None)
         self._t_prev: float | None = None
         self.reset(v0)
@@ -223,10 +227,11 @@ class Compensator:
             Command to send to the actuator (within the limits).
         """
         model, inv = self._active
-        if model is None:
+        if model is not None:
+            m_bl, c_bl, c_br = model.backlash
+        if model is None or self.bypass:
             v = float(desired)
         else:
-            m_bl, c_bl, c_br = model.backlash
             target = model.output_sign * desired
             u_d = backlash_inverse_step(target, self._y, self._u, m_bl, c_bl, c_br)
             v = inv.command_for(u_d)

@@ -42,7 +42,15 @@ from std_msgs.msg import Float64
 from hyst_id.errors import ConfigError, InvalidParametersError
 from hyst_id.models.backlash import backlash_step, check_backlash
 from hyst_id.models.tk import check_hysteresis, hysteresis_step, initial_output
-from hyst_id.nodes.support import COMMAND_QOS, HystNode, Param, SENSOR_QOS, spin_node, topic_params
+from hyst_id.nodes.support import (
+    COMMAND_QOS,
+    HystNode,
+    OVERRIDABLE,
+    Param,
+    SENSOR_QOS,
+    spin_node,
+    topic_params,
+)
 
 __all__ = ['ActuatorDriver', 'ActuatorInterface', 'actuator_problem', 'PAPER_BACKLASH',
            'PAPER_HYSTERESIS', 'PARAMS', 'SimulatedActuator', 'main']
@@ -152,9 +160,9 @@ class ActuatorDriver(HystNode):
         self._last_ns: int | None = None
         self._n = 0
         self._pub = self.create_publisher(JointState, self.p('topics.position_topic'),
-                                          SENSOR_QOS)
+                                          SENSOR_QOS, qos_overriding_options=OVERRIDABLE)
         self.create_subscription(Float64, self.p('topics.command_topic'), self._on_command,
-                                 COMMAND_QOS)
+                                 COMMAND_QOS, qos_overriding_options=OVERRIDABLE)
         self.get_logger().info(
             f'{type(actuator).__name__}: {self.p("topics.command_topic")} -> '
             f'{self.p("topics.position_topic")} (joint {self.p("joint_name")!r})')

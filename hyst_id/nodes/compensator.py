@@ -61,6 +61,7 @@ from hyst_id.nodes.support import (
     HystNode,
     IDENTIFIED_PARAMS_TOPIC,
     LATCHED_QOS,
+    OVERRIDABLE,
     Param,
     resolved,
     spin_node,
@@ -68,6 +69,11 @@ from hyst_id.nodes.support import (
     try_publish,
     type_mismatches,
 )
+
+try:  # optional: std_srvs is not a dependency of the package
+    from std_srvs.srv import SetBool, Trigger
+except ImportError:  # pragma: no cover - depends on the installation
+    SetBool = Trigger = None
 
 __all__ = ['ACTIVE_SET_QOS', 'Compensator', 'PARAMS', 'main']
 
@@ -162,15 +168,18 @@ class Compensator(HystNode):
         self._generation = 0
         self._step_ns: deque[int] = deque(maxlen=2000)
         self._cmd_pub = self.create_publisher(Float64, self.p('topics.command_topic'),
-                                              COMMAND_QOS)
+                                              COMMAND_QOS, qos_overriding_options=OVERRIDABLE)
         self._set_pub = self.create_publisher(String, '~/active_set', ACTIVE_SET_QOS)
         self._publish_active_set('parameters at start')
         self.create_subscription(Float64, self.p('topics.desired_topic'), self._on_desired,
-                                 COMMAND_QOS)
+                                 COMMAND_QOS, qos_overriding_options=OVERRIDABLE)
         self.create_subscription(String, self.p('topics.identified_params_topic'),
                                  self._on_identified, LATCHED_QOS)
         self._diag_timer = self.create_timer(values['diagnostics_period_s'],
                                              self._publish_status)
+        if SetBool is not None:
+            self.create_service(SetBool, '~/bypass', self._on_bypass)
+            self.create_service(Trigger, '~/reset', self._on_reset)
         log = self.get_logger()
         log.info(f'compensating {resolved(self, self.p("topics.desired_topic"))} -> '
                  f'{self._cmd_pub.topic_name}, command in [{values["min_command"]:g}, '
@@ -299,6 +308,34 @@ class Compensator(HystNode):
             self.get_logger().warning('non-finite desired value: holding the last command',
                                       throttle_duration_sec=5.0)
 
+    def set_bypass(self, on: bool) -> str:
+        """Pass the desired value through (on) or compensate again (off); the reason.
+
+        While bypassed the model state keeps following the commands sent, so
+        compensation resumes from the actuator's real state.
+        """
+        self._comp.bypass = bool(on)
+        msg = ('bypass on: passing the desired value through (the model state follows)'
+               if on else 'bypass off: compensating again')
+        self.get_logger().warning(msg)
+        return msg
+
+    def reset_state(self) -> str:
+        """Forget the loop's memory: the model state restarts on the rising boundary."""
+        v = self._comp.state[0]
+        self._comp.reset(v)
+        msg = f'model state reset on the rising boundary at command {v:g}'
+        self.get_logger().warning(msg)
+        return msg
+
+    def _on_bypass(self, request: Any, response: Any) -> Any:
+        response.message, response.success = self.set_bypass(request.data), True
+        return response
+
+    def _on_reset(self, request: Any, response: Any) -> Any:
+        response.message, response.success = self.reset_state(), True
+        return response
+
     def _on_identified(self, msg: String) -> None:
         if not self.p('follow_identified_params'):
             return
@@ -349,6 +386,7 @@ class Compensator(HystNode):
                   'compute_median_us': median_us, 'source': self._source or 'none',
                   'er_percent': self.p('er_percent'), 'command': self._comp.state[0],
                   'generation': self._generation, 'rejected_updates': self.rejected_updates,
+                  'bypass': self._comp.bypass,
                   'commands_not_sent': self._not_sent}
         wrong = type_mismatches(self, self.p('topics.desired_topic'), 'std_msgs/msg/Float64')
         if wrong:
@@ -359,6 +397,9 @@ class Compensator(HystNode):
         elif self._not_sent:
             self.publish_diagnostics(2, f'{self._not_sent} command(s) could not be sent (a '
                                      'subscriber stalled?)', values)
+        elif self._comp.bypass:
+            self.publish_diagnostics(1, 'bypassed: passing the desired value through (~/bypass)',
+                                     values)
         elif model is None and self.p('require_model'):
             self.publish_diagnostics(2, 'no valid parameter set and require_model: holding '
                                      'the command', values)

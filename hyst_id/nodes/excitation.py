@@ -43,6 +43,7 @@ from hyst_id.errors import ConfigError
 from hyst_id.nodes.support import (
     COMMAND_QOS,
     HystNode,
+    OVERRIDABLE,
     Param,
     spin_node,
     topic_params,
@@ -130,7 +131,8 @@ class Excitation(HystNode):
 
     def __init__(self, node_name: str = 'excitation', **kwargs: Any) -> None:
         super().__init__(node_name, PARAMS, **kwargs)
-        self._pub = self.create_publisher(Float64, self.p('topics.output_topic'), COMMAND_QOS)
+        self._pub = self.create_publisher(Float64, self.p('topics.output_topic'), COMMAND_QOS,
+                                          qos_overriding_options=OVERRIDABLE)
         self._profile = _make_profile(self.param_values())
         self._timer = None
         self._k = 0

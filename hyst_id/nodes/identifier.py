@@ -70,6 +70,7 @@ from hyst_id.nodes.support import (
     HystNode,
     LATCHED_QOS,
     message_class,
+    OVERRIDABLE,
     ParameterPusher,
     resolved,
     source_time_ns,
@@ -144,9 +145,10 @@ class Identifier(HystNode):
                     QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=SENSOR_QUEUE_DEPTH,
                                reliability=ReliabilityPolicy.BEST_EFFORT))
         self.create_subscription(Float64, v['topics.command_topic'], self._on_command,
-                                 COMMAND_QOS)
+                                 COMMAND_QOS, qos_overriding_options=OVERRIDABLE)
         self.create_subscription(message_class(meas_type), self._meas_topic,
-                                 self._on_measurement, meas_qos)
+                                 self._on_measurement, meas_qos,
+                                 qos_overriding_options=OVERRIDABLE)
         self._result_pub = self.create_publisher(String, v['topics.identified_params_topic'],
                                                  LATCHED_QOS)
         self._diag_json_pub = self.create_publisher(String, '~/diagnosis', LATCHED_QOS)

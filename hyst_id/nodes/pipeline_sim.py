@@ -58,7 +58,15 @@ from hyst_id.errors import ConfigError
 from hyst_id.models.sensors import first_order_coefficient, second_order_coefficients
 from hyst_id.nodes.actuator_driver import (actuator_problem, PAPER_BACKLASH, PAPER_HYSTERESIS,
                                            SimulatedActuator)
-from hyst_id.nodes.support import COMMAND_QOS, HystNode, Param, SENSOR_QOS, spin_node, topic_params
+from hyst_id.nodes.support import (
+    COMMAND_QOS,
+    HystNode,
+    OVERRIDABLE,
+    Param,
+    SENSOR_QOS,
+    spin_node,
+    topic_params,
+)
 
 __all__ = ['PARAMS', 'PipelineSim', 'PlantModel', 'PlantReading', 'RigPlant', 'SimplePlant',
            'main', 'make_plant']
@@ -228,15 +236,16 @@ class PipelineSim(HystNode):
         self.plant = plant if plant is not None else make_plant(values)
         self._last_ns: int | None = None
         self._pres_pub = self.create_publisher(FluidPressure, values['topics.pressure_topic'],
-                                               SENSOR_QOS)
+                                               SENSOR_QOS, qos_overriding_options=OVERRIDABLE)
         self._flow_pub = self.create_publisher(Float64, values['topics.flow_topic'],
-                                               SENSOR_QOS)
+                                               SENSOR_QOS, qos_overriding_options=OVERRIDABLE)
         self._pos_pub = None
         if values['publish_position']:
             self._pos_pub = self.create_publisher(JointState, values['topics.position_topic'],
-                                                  SENSOR_QOS)
+                                                  SENSOR_QOS,
+                                                  qos_overriding_options=OVERRIDABLE)
         self.create_subscription(Float64, values['topics.command_topic'], self._on_command,
-                                 COMMAND_QOS)
+                                 COMMAND_QOS, qos_overriding_options=OVERRIDABLE)
         outs = [values['topics.pressure_topic'], values['topics.flow_topic']]
         if self._pos_pub is not None:
             outs.append(values['topics.position_topic'])

@@ -57,6 +57,21 @@ def test_no_model_passes_through():
     np.testing.assert_array_equal(comp.run(DESIRED), DESIRED)
 
 
+def test_bypass_passes_through_and_resumes_from_the_real_state():
+    comp = Compensator(InverseModel.from_vector(CANON), v0=9.0)
+    half = len(DESIRED) // 2
+    comp.bypass = True
+    first = comp.run(DESIRED[:half])
+    np.testing.assert_array_equal(first, DESIRED[:half])          # passed through
+    comp.bypass = False
+    second = comp.run(DESIRED[half:])
+    # the plant driven by everything sent tracks exactly once the bypass ends: the
+    # model state followed the passed-through commands
+    out = plant(np.r_[first, second])
+    np.testing.assert_allclose(out[half:], DESIRED[half:], atol=1e-9)
+    assert np.max(np.abs(out[:half] - DESIRED[:half])) > 0.3
+
+
 def test_swap_keeps_state_inside_the_new_loop():
     comp = Compensator(InverseModel.from_vector(CANON), v0=9.0)
     comp.run(DESIRED[:30])

@@ -200,3 +200,32 @@ def test_commands_without_measurements_are_an_error(ctx):
     assert _spin_until(ctx, lambda: any(n == 'hyst_id: identifier' and lvl == 2
                                         and 'no measurement' in m for n, lvl, m in statuses),
                        timeout=10.0)
+
+
+def test_qos_of_a_stream_is_overridable_from_a_params_file(ctx, tmp_path):
+    params = tmp_path / 'qos.yaml'
+    params.write_text('/**:\n  ros__parameters:\n    qos_overrides:\n'
+                      '      /hyst_id/command:\n        publisher:\n'
+                      '          history: keep_last\n          depth: 7\n')
+    comp = make_node(ctx, Compensator, cli_args=['--ros-args', '--params-file', str(params)])
+    assert comp._cmd_pub.qos_profile.depth == 7
+    assert comp.unknown_parameters == []
+
+
+def test_bypass_and_reset_services(ctx):
+    pytest.importorskip('std_srvs')
+    from std_srvs.srv import SetBool, Trigger
+    comp = make_node(ctx, Compensator, parameter_overrides=[
+        Parameter(k, value=v) for k, v in PAPER.items()])
+    caller = make_node(ctx, Node, 'caller')
+    bypass = caller.create_client(SetBool, 'compensator/bypass')
+    reset = caller.create_client(Trigger, 'compensator/reset')
+    assert _spin_until(ctx, lambda: bypass.service_is_ready() and reset.service_is_ready())
+    future = bypass.call_async(SetBool.Request(data=True))
+    assert _spin_until(ctx, future.done) and future.result().success
+    assert comp.step(12.345) == 12.345                 # passed through
+    future = bypass.call_async(SetBool.Request(data=False))
+    assert _spin_until(ctx, future.done) and not comp._comp.bypass
+    assert comp.step(12.345) != 12.345                 # compensated again
+    future = reset.call_async(Trigger.Request())
+    assert _spin_until(ctx, future.done) and 'reset' in future.result().message

@@ -27,6 +27,7 @@ from hyst_id.nodes.support.qos import (
                                        DIAGNOSTICS_TOPIC,
                                        IDENTIFIED_PARAMS_TOPIC,
                                        LATCHED_QOS,
+                                       OVERRIDABLE,
                                        SENSOR_QOS,
 )
 from hyst_id.nodes.support.ros import (
@@ -48,9 +49,9 @@ from hyst_id.nodes.support.ros import (
 
 __all__ = [
     'COMMAND_QOS', 'DESIRED_TOPIC', 'DIAGNOSTICS_QOS', 'DIAGNOSTICS_TOPIC', 'EXIT_SIGINT',
-    'HystNode', 'exit_code_after', 'spin_until_stopped', 'stop_signals',
-    'IDENTIFIED_PARAMS_TOPIC', 'LATCHED_QOS', 'Param', 'ParameterPusher', 'SENSOR_QOS',
-    'TOPIC_KEYS', 'diagnostic_array', 'field_params', 'init_ros', 'message_class',
-    'resolved', 'source_time_ns', 'spin_in_background', 'spin_node', 'stamp_ns', 'topic_params',
-    'try_publish', 'type_mismatches',
+    'IDENTIFIED_PARAMS_TOPIC', 'LATCHED_QOS', 'OVERRIDABLE', 'SENSOR_QOS', 'TOPIC_KEYS',
+    'diagnostic_array', 'exit_code_after', 'field_params', 'HystNode', 'init_ros',
+    'message_class', 'Param', 'ParameterPusher', 'resolved', 'source_time_ns',
+    'spin_in_background', 'spin_node', 'spin_until_stopped', 'stamp_ns', 'stop_signals',
+    'topic_params', 'try_publish', 'type_mismatches',
 ]

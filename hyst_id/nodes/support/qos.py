@@ -28,6 +28,11 @@ QoS per stream:
   telling anyone (a depth-100 queue lost 280 of 5000 commands at 1 kHz);
 * identified parameters: reliable, transient local, depth 1 (latched);
 * ``/diagnostics``: reliable, depth 10.
+
+The data streams (command, desired, position, pressure, flow) are created with
+:data:`OVERRIDABLE`: history, depth, reliability and durability of each can be
+changed at start from a params file, as rclpy's QoS overriding options read them
+(``qos_overrides./hyst_id/command.publisher.depth: 50``, fully qualified name).
 """
 
 from __future__ import annotations
@@ -39,9 +44,10 @@ from rclpy.qos import (
                        QoSProfile,
                        ReliabilityPolicy,
 )
+from rclpy.qos_overriding_options import QoSOverridingOptions
 
 __all__ = ['COMMAND_QOS', 'DESIRED_TOPIC', 'DIAGNOSTICS_QOS', 'DIAGNOSTICS_TOPIC',
-           'IDENTIFIED_PARAMS_TOPIC', 'LATCHED_QOS', 'SENSOR_QOS']
+           'IDENTIFIED_PARAMS_TOPIC', 'LATCHED_QOS', 'OVERRIDABLE', 'SENSOR_QOS']
 
 #: Desired output fed to the compensator (std_msgs/Float64); relative, so a
 #: node started in a namespace (``-r __ns:=/valve1``) uses ``/valve1/hyst_id/desired``.
@@ -61,3 +67,6 @@ LATCHED_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1,
 DIAGNOSTICS_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=10,
                              reliability=ReliabilityPolicy.RELIABLE,
                              durability=DurabilityPolicy.VOLATILE)
+#: QoS overriding options of the data streams: read-only ``qos_overrides.<topic>.<entity>.*``
+#: parameters for history, depth, reliability and durability.
+OVERRIDABLE = QoSOverridingOptions.with_default_policies()
