@@ -41,6 +41,7 @@ COMMANDS = {
     'diagnose': ('diagnose', 'find, name and model what a recording has that the model lacks'),
     'simulate': ('simulate', 'simulate the pneumatic rig and write a recording'),
     'experiment': ('experiment', "reproduce the paper's section 4 experiment"),
+    'fleet': ('fleet', 'identify (and diagnose) many recordings: a table, trends per valve'),
 }
 
 

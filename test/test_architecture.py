@@ -41,8 +41,8 @@ RANKS = {
     'identification': 4,
     'compensation': 5, 'rig': 5,
     'diagnosis': 6,
-    'experiment': 7, 'live': 7,
-    'fleet': 8, 'commands': 8, 'nodes': 8,
+    'experiment': 7, 'live': 7, 'fleet': 7,
+    'commands': 8, 'nodes': 8,
     'cli': 9,
 }
 ROS_MODULES = ('rclpy', 'std_msgs', 'sensor_msgs', 'diagnostic_msgs', 'rcl_interfaces',

@@ -1,0 +1,206 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""Find a fleet's recordings, run one task per recording on an engine, resume.
+
+Engines: a local process pool (default), or a Dask distributed cluster
+(``address``: a scheduler address such as ``tcp://10.0.0.5:8786``, or
+``local`` for a cluster started on this machine), used through its
+:class:`concurrent.futures.Executor` interface (``Client.get_executor``), so
+the same loop drives both and no scheduling is written here. Dask rather
+than Ray: it installs from PyPI as pure Python (Ray's wheels are large and
+platform-bound), joins an existing cluster from an address alone, and its
+executor is the standard one.
+"""
+
+from __future__ import annotations
+
+from concurrent.futures import as_completed, Executor, ProcessPoolExecutor
+from dataclasses import asdict, dataclass
+import glob
+import hashlib
+import json
+import os
+from pathlib import Path
+import time
+from typing import Any, Callable, Iterable
+
+from hyst_id.errors import ConfigError, HystIdError
+
+__all__ = ['FleetOptions', 'find_recordings', 'fleet_task', 'result_path', 'run_fleet']
+
+_RECORDING_SUFFIXES = ('.mcap', '.csv', '.tsv')
+
+
+@dataclass(frozen=True)
+class FleetOptions:
+    """What to do with each recording (picklable: it travels to the workers)."""
+
+    channel: str = 'position'
+    seeds: int = 4
+    generations: int = 500
+    model: str = 'tk'
+    diagnose: bool = False
+    #: A :class:`~hyst_id.io.topics.TopicConfig` or mapping of topic keys (bags), or None.
+    topics: Any = None
+
+
+def find_recordings(inputs: Iterable[str]) -> list[Path]:
+    """Recordings under directories and globs: bag directories, ``.mcap`` and CSV files.
+
+    A directory holding ``metadata.yaml`` is one bag; other directories are
+    searched recursively. The list is sorted and free of repeats.
+
+    Raises
+    ------
+    ConfigError
+        An input matches nothing.
+    """
+    found: dict[str, Path] = {}
+    for item in inputs:
+        matches = [Path(p) for p in sorted(glob.glob(str(item)))]
+        if not matches and Path(item).exists():
+            matches = [Path(item)]
+        if not matches:
+            raise ConfigError(f'{item}: no such file, directory or glob match')
+        for path in matches:
+            for rec in _walk(path):
+                found[str(rec.resolve())] = rec
+    return [found[k] for k in sorted(found)]
+
+
+def _walk(path: Path) -> Iterable[Path]:
+    if path.is_file():
+        if path.suffix.lower() in _RECORDING_SUFFIXES:
+            yield path
+        return
+    if (path / 'metadata.yaml').exists():
+        yield path
+        return
+    if path.is_dir():
+        for child in sorted(path.iterdir()):
+            yield from _walk(child)
+
+
+def result_path(out_dir: Path, recording: Path) -> Path:
+    """Where a recording's JSON goes: its name plus a short hash of its full path."""
+    digest = hashlib.sha1(str(Path(recording).resolve()).encode()).hexdigest()[:8]
+    return Path(out_dir) / 'recordings' / f'{Path(recording).name}-{digest}.json'
+
+
+def fleet_task(path: str, options: FleetOptions) -> dict:
+    """Identify (and diagnose) one recording; a document, never an exception.
+
+    ``status`` is ``ok`` or ``error`` (with ``error``: the one-line reason a
+    bad recording gives).
+    """
+    t0 = time.monotonic()
+    doc: dict[str, Any] = {'recording': path,
+                           'options': {**asdict(options), 'topics': str(options.topics or '')}}
+    try:
+        from hyst_id.identification import identify
+        from hyst_id.identification.config import make_settings, make_spec
+        from hyst_id.io.readers import read_recording
+
+        rec = read_recording(path, options.channel, topics=options.topics or None)
+        spec = make_spec(rec, 'auto', family=options.model)
+        settings = make_settings(seeds=options.seeds, generations=options.generations,
+                                 workers=1)
+        ident = identify(rec, spec=spec, settings=settings)
+        doc.update(status='ok', identification=ident.to_dict(), n_samples=rec.n_samples,
+                   duration_s=rec.duration_s, source=rec.source, notes=list(rec.notes))
+        if options.diagnose:
+            from hyst_id.diagnosis import diagnose
+            doc['diagnosis'] = diagnose(rec).to_dict()
+    except HystIdError as exc:
+        doc.update(status='error', error=(str(exc).splitlines() or [type(exc).__name__])[0])
+    except Exception as exc:  # noqa: BLE001 - one bad recording never stops the fleet
+        doc.update(status='error', error=f'{type(exc).__name__}: {exc}'.splitlines()[0])
+    doc['elapsed_s'] = time.monotonic() - t0
+    return doc
+
+
+def _executor(address: str | None, workers: int) -> tuple[Executor, Callable[[], None]]:
+    if not address:
+        pool = ProcessPoolExecutor(max_workers=workers or os.cpu_count() or 1)
+        return pool, lambda: pool.shutdown(wait=True, cancel_futures=True)
+    try:
+        from distributed import Client, LocalCluster
+    except ImportError:
+        raise ConfigError('--address needs the dask distributed package '
+                          '(pip install distributed)') from None
+    if address == 'local':
+        cluster = LocalCluster(n_workers=workers or os.cpu_count() or 1,
+                               threads_per_worker=1, processes=True, dashboard_address=None)
+        client = Client(cluster)
+
+        def close() -> None:
+            client.close()
+            cluster.close()
+    else:
+        try:
+            client = Client(address, timeout='10s')
+        except (OSError, TimeoutError) as exc:
+            raise ConfigError(f'cannot reach the Dask scheduler at {address}: {exc}') from None
+        close = client.close
+    return client.get_executor(pure=False), close
+
+
+def run_fleet(recordings: list[Path], out_dir: str | Path, options: FleetOptions, *,
+              workers: int = 0, address: str | None = None,
+              progress: Callable[[int, int, dict], None] | None = None) -> list[dict]:
+    """Run :func:`fleet_task` over ``recordings``; return every document (old and new).
+
+    A recording whose JSON in ``out_dir/recordings`` already says ``ok`` is
+    not run again (resume; its document gets ``resumed: true``); failed
+    ones are retried. Each document is written as soon as it arrives, so an
+    interrupted fleet loses only the running tasks.
+    """
+    out_dir = Path(out_dir)
+    (out_dir / 'recordings').mkdir(parents=True, exist_ok=True)
+    docs: dict[str, dict] = {}
+    todo = []
+    for rec in recordings:
+        old = _read(result_path(out_dir, rec))
+        if old is not None and old.get('status') == 'ok':
+            docs[str(rec)] = {**old, 'resumed': True}
+        else:
+            todo.append(rec)
+    if todo:
+        executor, close = _executor(address, workers)
+        try:
+            futures = {executor.submit(fleet_task, str(rec), options): rec for rec in todo}
+            for k, fut in enumerate(as_completed(futures), 1):
+                rec = futures[fut]
+                doc = fut.result()
+                _write(result_path(out_dir, rec), doc)
+                docs[str(rec)] = doc
+                if progress:
+                    progress(k, len(todo), doc)
+        finally:
+            close()
+    return [docs[str(rec)] for rec in recordings]
+
+
+def _read(path: Path) -> dict | None:
+    try:
+        return json.loads(path.read_text())
+    except (OSError, ValueError):
+        return None
+
+
+def _write(path: Path, doc: dict) -> None:
+    tmp = path.with_name(path.name + '.tmp')
+    tmp.write_text(json.dumps(doc, default=float))
+    os.replace(tmp, path)

@@ -1,0 +1,126 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""The fleet runner: many bags, bad ones among them, resume, trends, a Dask cluster.
+
+Recordings are simulated with the independent reference simulator
+(``test/reference_sim``), not with the package's own chain: valve A's
+backlash widens over four recordings a week apart, valve B's stays; a bag
+with a corrupt file, a directory with a broken ``metadata.yaml`` and a CSV
+without excitation are in the same fleet.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from reference_sim import backlash, hysteresis
+
+from hyst_id.cli import main as cli_main
+from hyst_id.fleet import find_recordings, FleetOptions, loop_trends, run_fleet
+from hyst_id.fleet.table import fleet_rows
+from hyst_id.io.bag import write_recording_bag
+from hyst_id.io.recording import Recording
+
+WEEK_NS = 7 * 86400 * 10**9
+FAST = FleetOptions(seeds=1, generations=80)
+
+
+def _recording(half_band: float, seed: int) -> Recording:
+    t = np.arange(1200) * 0.05
+    v = 9.0 + 4.0 * np.sin(2 * np.pi * t / 15.0) * (0.5 + 0.5 * np.exp(-t / 40.0))
+    u = hysteresis(v, 1.01, 1.05, 0.10, 0.15, -0.25, 0.50, 14.0, 7.0)
+    y = backlash(u, 1.0, -half_band, half_band)
+    y = y + np.random.default_rng(seed).normal(0.0, 0.01, t.size)
+    return Recording(t, v, y, 'position', 'mA', '')
+
+
+@pytest.fixture(scope='module')
+def fleet_dir(tmp_path_factory):
+    root = tmp_path_factory.mktemp('fleet')
+    for k, band in enumerate((0.10, 0.13, 0.16, 0.19)):          # valve A wears
+        write_recording_bag(root / 'valve_a' / f'week{k}', _recording(band, k),
+                            start_ns=1_800_000_000 * 10**9 + k * WEEK_NS)
+    for k in range(3):                                          # valve B does not
+        write_recording_bag(root / 'valve_b' / f'week{k}', _recording(0.15, 10 + k),
+                            start_ns=1_800_000_000 * 10**9 + k * WEEK_NS)
+    bad = root / 'bad'
+    (bad / 'broken_bag').mkdir(parents=True)
+    (bad / 'broken_bag' / 'metadata.yaml').write_text('rosbag2_bagfile_information: [\n')
+    (bad / 'junk.mcap').write_bytes(b'\x89MCAP0\r\n' + bytes(range(200)))
+    t = np.arange(200) * 0.1
+    np.savetxt(bad / 'flat.csv', np.c_[t, np.full(t.size, 9.0), np.sin(t)], delimiter=',',
+               header='t,command,measurement', comments='')
+    return root
+
+
+def test_find_recordings(fleet_dir):
+    found = find_recordings([str(fleet_dir)])
+    assert len(found) == 10
+    assert {p.name for p in found} >= {'week0', 'broken_bag', 'junk.mcap', 'flat.csv'}
+    assert find_recordings([str(fleet_dir / 'valve_*' / 'week0')]) == [
+        fleet_dir / 'valve_a' / 'week0', fleet_dir / 'valve_b' / 'week0']
+
+
+def test_fleet_rows_errors_resume_and_trends(fleet_dir, tmp_path):
+    recs = find_recordings([str(fleet_dir)])
+    seen = []
+    docs = run_fleet(recs, tmp_path, FAST, workers=2,
+                     progress=lambda k, n, d: seen.append(d['recording']))
+    assert len(seen) == 10
+    rows = fleet_rows(docs)
+    bad = {r['recording'].split('/')[-1]: r['error'] for r in rows if r['status'] != 'ok'}
+    assert set(bad) == {'broken_bag', 'junk.mcap', 'flat.csv'}, bad
+    assert all(bad.values()) and 'nothing excites' in bad['flat.csv']
+    good = [r for r in rows if r['status'] == 'ok']
+    assert all(r['er_over_floor'] < 1.5 for r in good), [r['er_over_floor'] for r in good]
+    a = sorted((r for r in good if r['valve'] == 'valve_a'), key=lambda r: r['start_epoch_s'])
+    widths = [r['backlash_width'] for r in a]
+    assert np.allclose(widths, [0.2, 0.26, 0.32, 0.38], atol=0.03), widths
+    trends = {(t['valve'], t['metric']): t for t in loop_trends(rows)}
+    assert trends[('valve_a', 'backlash_width')]['flagged']
+    assert not trends[('valve_b', 'backlash_width')]['flagged']
+    assert not trends[('valve_b', 'loop_width')]['flagged']
+    # resume: the good ones are not run again, the bad ones are retried
+    seen.clear()
+    again = run_fleet(recs, tmp_path, FAST, workers=2,
+                      progress=lambda k, n, d: seen.append(d['recording']))
+    assert len(seen) == 3 and sum(bool(d.get('resumed')) for d in again) == 7
+
+
+def test_cli_fleet_writes_table_and_trends(fleet_dir, tmp_path, capsys):
+    code = cli_main(['fleet', str(fleet_dir / 'valve_a'), str(fleet_dir / 'bad' / 'flat.csv'),
+                     '--out', str(tmp_path), '--seeds', '1', '--generations', '80',
+                     '--workers', '2', '--no-progress'])
+    out = capsys.readouterr().out
+    assert code == 1                                   # one recording failed
+    assert '4 identified' in out and '1 failed' in out and 'flat.csv' in out
+    assert 'trend: valve valve_a: backlash_width' in out
+    header = (tmp_path / 'fleet.csv').read_text().splitlines()[0].split(',')
+    assert {'recording', 'valve', 'status', 'er_percent', 'p.c_br', 'backlash_width'} <= set(
+        header)
+    trends = json.loads((tmp_path / 'trends.json').read_text())
+    assert any(t['flagged'] for t in trends)
+
+
+@pytest.mark.slow
+def test_fleet_on_a_local_dask_cluster(fleet_dir, tmp_path):
+    pytest.importorskip('distributed')
+    recs = find_recordings([str(fleet_dir / 'valve_b'), str(fleet_dir / 'bad')])
+    docs = run_fleet(recs, tmp_path, FAST, workers=2, address='local')
+    status = {d['recording'].split('/')[-1]: d['status'] for d in docs}
+    assert status == {'week0': 'ok', 'week1': 'ok', 'week2': 'ok', 'broken_bag': 'error',
+                      'junk.mcap': 'error', 'flat.csv': 'error'}
