@@ -35,20 +35,11 @@ from pathlib import Path
 import random
 import signal
 import statistics
-import subprocess
 import sys
 import tempfile
-import time
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / 'test' / 'nodes'))
-from test_interrupts import (  # noqa: E402, I100
-    _children_running,
-    _tagged,
-    _WORKER_SCRIPT,
-    node_command,
-    NODES,
-    stop_once,
-)
+from test_interrupts import node_command, NODES, orphans_after, stop_once  # noqa: E402, I100
 
 
 def stress_node(node: str, repeats: int, rng: random.Random, tmp: Path) -> dict:
@@ -67,31 +58,6 @@ def stress_node(node: str, repeats: int, rng: random.Random, tmp: Path) -> dict:
             'bad_exits': sum('exit' in p for p in problems), 'problems': problems,
             'median_s': statistics.median(times) if times else float('nan'),
             'max_s': max(times) if times else float('nan')}
-
-
-def orphans(sig: int, tmp: Path, k: int) -> int:
-    """Kill an identification with two workers; worker processes left after 10 s."""
-    key, value = 'HYST_ID_ORPHAN_TAG', f'{tmp.name}-{sig}-{k}'
-    tag = f'{key}={value}'
-    proc = subprocess.Popen([sys.executable, '-c', _WORKER_SCRIPT],
-                            env={**os.environ, key: value}, stdout=subprocess.PIPE,
-                            stderr=subprocess.STDOUT)
-    try:
-        proc.stdout.readline()
-        if not _children_running(tag, 60.0):
-            return -1
-        proc.send_signal(sig)
-        proc.wait(20)
-        deadline = time.monotonic() + 10.0
-        while _tagged(tag) and time.monotonic() < deadline:
-            time.sleep(0.1)
-        left = _tagged(tag)
-        for pid in left:
-            os.kill(pid, signal.SIGKILL)
-        return len(left)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
 
 
 def main() -> None:
@@ -116,7 +82,7 @@ def main() -> None:
                 print(f'#   {node}: {p}')
         n = max(1, args.repeats // 4)
         for sig in (signal.SIGKILL, signal.SIGINT):
-            left = [orphans(sig, Path(d), k) for k in range(n)]
+            left = [orphans_after(sig, f'{Path(d).name}-{sig}-{k}') for k in range(n)]
             print(f'# identification with 2 workers, {signal.Signals(sig).name} x {n}: '
                   f'{sum(x for x in left if x > 0)} worker process(es) left behind'
                   + (f', {left.count(-1)} runs whose workers never started'

@@ -142,16 +142,19 @@ def _children_running(tag: str, timeout_s: float) -> bool:
     return False
 
 
-@pytest.mark.skipif(not sys.platform.startswith('linux'), reason='/proc and PR_SET_PDEATHSIG')
-@pytest.mark.parametrize('sig', [signal.SIGKILL, signal.SIGINT])
-def test_worker_processes_do_not_outlive_their_parent(sig, tmp_path):
-    tag = f'HYST_ID_ORPHAN_TAG={tmp_path.name}{sig}'
-    key, value = tag.split('=')
-    proc = subprocess.Popen([sys.executable, '-c', _WORKER_SCRIPT], env={**os.environ,
-                            key: value}, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+def orphans_after(sig: int, tag_value: str) -> int:
+    """Stop an identification with two workers by ``sig``; workers left after 10 s.
+
+    -1 when the workers never started. Leftovers are killed before returning.
+    """
+    key = 'HYST_ID_ORPHAN_TAG'
+    tag = f'{key}={tag_value}'
+    proc = subprocess.Popen([sys.executable, '-c', _WORKER_SCRIPT],
+                            env={**os.environ, key: tag_value}, stdout=subprocess.PIPE,
+                            stderr=subprocess.STDOUT)
     try:
-        assert proc.stdout.readline().strip() == b'start'
-        assert _children_running(tag, 60.0), 'the worker processes never started'
+        if proc.stdout.readline().strip() != b'start' or not _children_running(tag, 60.0):
+            return -1
         proc.send_signal(sig)
         proc.wait(20)
         deadline = time.monotonic() + 10.0
@@ -160,10 +163,18 @@ def test_worker_processes_do_not_outlive_their_parent(sig, tmp_path):
         left = _tagged(tag)
         for pid in left:
             os.kill(pid, signal.SIGKILL)
-        assert not left, f'{len(left)} worker process(es) outlived their parent'
+        return len(left)
     finally:
         if proc.poll() is None:
             proc.kill()
+
+
+@pytest.mark.skipif(not sys.platform.startswith('linux'), reason='/proc and PR_SET_PDEATHSIG')
+@pytest.mark.parametrize('sig', [signal.SIGKILL, signal.SIGINT])
+def test_worker_processes_do_not_outlive_their_parent(sig, tmp_path):
+    left = orphans_after(sig, f'{tmp_path.name}{sig}')
+    assert left != -1, 'the worker processes never started'
+    assert left == 0, f'{left} worker process(es) outlived their parent'
 
 
 def test_a_cancel_ends_worker_processes_at_once():
