@@ -30,7 +30,12 @@
 
 When the baseline residual is white, independent of the command and at the
 noise floor on held-out data, no mechanism is tested and the verdict is
-``none``.
+``none``. When mechanisms were tested, none was accepted and the held-out
+error stays above :data:`UNKNOWN_FACTOR` x the noise floor, the verdict is
+``unknown``: something is missing and it is not in the library. Whenever
+that much is left (with or without findings), an empirical block
+(:mod:`hyst_id.diagnosis.empirical`) measures what a model could still gain
+and which features of the command and time carry it.
 """
 
 from __future__ import annotations
@@ -41,6 +46,7 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from hyst_id.diagnosis.baseline import baseline_starts
+from hyst_id.diagnosis.empirical import empirical_block
 from hyst_id.diagnosis.locate import Localization, locate, noise_std
 from hyst_id.diagnosis.mechanisms import get_mechanisms
 from hyst_id.diagnosis.mechanisms.base import Context, Mechanism
@@ -65,7 +71,10 @@ from hyst_id.signals.noise import floor_percent
 from hyst_id.signals.reversals import period_s
 from hyst_id.signals.split import split_index
 
-__all__ = ['diagnose', 'finding_from', 'located_where', 'range_note']
+__all__ = ['UNKNOWN_FACTOR', 'diagnose', 'finding_from', 'located_where', 'range_note']
+
+#: Held-out %e_r over the noise floor above which what is left counts as missing physics.
+UNKNOWN_FACTOR = 1.5
 
 
 def _info(fit: FitResult, ctx: Context, command: np.ndarray) -> dict:
@@ -229,8 +238,18 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
         loc = locate(t, v_orig, y, current.prediction, sigma, n_train, ctx.period_s)
     final_loc = loc if current is not baseline else loc0
     notes = list(rec.notes) + range_note(v_orig, n_train)
+    empirical = None
+    if current.er_holdout_percent > UNKNOWN_FACTOR * floor_h:
+        say('empirical block: what a model could still gain')
+        empirical = empirical_block(t, v_orig, y, current.prediction, n_train, ctx.period_s)
+    if findings:
+        verdict = findings[0].mechanism
+    elif rounds and current.er_holdout_percent > UNKNOWN_FACTOR * floor_h:
+        verdict = 'unknown'     # something is missing, and it is none of the library
+    else:
+        verdict = 'none'
     return Diagnosis(channel=rec.channel, source=rec.source, mode='model',
-                     verdict=findings[0].mechanism if findings else 'none', t_s=t,
+                     verdict=verdict, empirical=empirical, t_s=t,
                      command=v_orig, measurement=y, n_train=n_train, baseline=baseline,
                      final=current, findings=findings, localization=loc0,
                      final_localization=final_loc, noise_std=sigma,

@@ -59,12 +59,19 @@ def format_diagnosis(d: Any) -> str:
             lines.append('verdict: none - the baseline residual is white, independent of the '
                          'command and at the noise floor on held-out data: this record shows no '
                          'physics that the model leaves out.')
+        elif d.verdict == 'unknown':
+            ratio = d.baseline.er_holdout_percent / d.noise_floor_percent
+            lines.append('verdict: unknown - the model misses something '
+                         f'({ratio:.2f} x the noise floor on held-out data) and no mechanism '
+                         'of the library explains it (table below); where it shows is above.')
         else:
             ratio = d.baseline.er_holdout_percent / d.noise_floor_percent
             lines.append('verdict: none - no mechanism of the library improves the held-out '
                          'error significantly (table below). The remaining mismatch '
-                         f'({ratio:.2f} x the noise floor on held-out data) is not one of the '
-                         'modelled physics.')
+                         f'({ratio:.2f} x the noise floor on held-out data) is within what '
+                         'the noise allows.')
+    if d.empirical is not None:
+        lines.append(f'what is left: {d.empirical.summary()}.')
     for i, f in enumerate(d.findings):
         head = 'verdict' if i == 0 else f'finding {i + 1}'
         gain = 100 * (1 - f.er_holdout_after_percent / f.er_holdout_before_percent)

@@ -22,6 +22,7 @@ with its JSON document, its ``/diagnostics`` status and its text report).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -121,6 +122,8 @@ class Diagnosis:
     command_unit: str = ''
     notes: list = field(default_factory=list)
     extra: dict = field(default_factory=dict)
+    #: What a model could still gain (:class:`~hyst_id.diagnosis.empirical.EmpiricalBlock`).
+    empirical: Any = None
 
     @property
     def train_fraction(self) -> float:
@@ -153,6 +156,7 @@ class Diagnosis:
                 self.measurement_unit), 'white': self.final_localization.white,
                 'independent': self.final_localization.independent},
             'tested': self.rounds, 'notes': list(self.notes),
+            'empirical': None if self.empirical is None else self.empirical.to_dict(),
         }
         out.update(self.extra)
         return jsonable(out)
@@ -171,6 +175,9 @@ class Diagnosis:
         for f in self.findings:
             for name, q in f.params.items():
                 values[f'{f.mechanism}.{name}'] = f'{q.value:.4g} {q.unit}'.strip()
+        if self.verdict == 'unknown':
+            return 'warn', ('something is missing that no mechanism of the library explains'
+                            + (f': {self.empirical.summary()}' if self.empirical else '')), values
         if not self.findings:
             return 'ok', 'no missing physics found', values
         f = self.findings[0]
