@@ -20,20 +20,26 @@ every :data:`POLL_S` and, when it holds (or anything goes wrong), ends the
 workers at once instead of waiting for the running tasks. Each worker
 ignores SIGINT (Ctrl-C is the parent's to handle) and, on Linux, is sent
 SIGTERM by the kernel when its parent dies (``PR_SET_PDEATHSIG``), so a
-parent killed outright leaves no worker behind.
+parent killed outright leaves no worker behind. In the parent, when called
+from the main thread with Python's default Ctrl-C handler, a SIGINT is only
+noted while the pool runs and raised as :class:`KeyboardInterrupt` at the
+next poll: raised asynchronously it can land while the executor holds one of
+its locks, and ending the pool then deadlocks (seen once in 100 stops under
+load by ``bench/stop_stress.py``).
 """
 
 from __future__ import annotations
 
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
+from contextlib import contextmanager
 import ctypes
 import multiprocessing
 import os
 import signal
 import sys
 import threading
-from typing import Any, Callable, Sequence
+from typing import Any, Callable, Iterator, Sequence
 
 from threadpoolctl import threadpool_limits
 
@@ -88,6 +94,21 @@ def _end(pool: ProcessPoolExecutor) -> None:
             proc.kill()
 
 
+@contextmanager
+def _sigint_deferred() -> Iterator[Callable[[], bool]]:
+    """Note Ctrl-C instead of raising it where it lands (main thread, default handler only)."""
+    if (threading.current_thread() is not threading.main_thread()
+            or signal.getsignal(signal.SIGINT) is not signal.default_int_handler):
+        yield lambda: False
+        return
+    hits: list[int] = []
+    previous = signal.signal(signal.SIGINT, lambda signum, frame: hits.append(signum))
+    try:
+        yield lambda: bool(hits)
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
 def map_in_processes(fn: Callable[..., Any], arg_tuples: Sequence[tuple], n_workers: int, *,
                      on_result: Callable[[Any], None] | None = None,
                      should_stop: Callable[[], bool] | None = None) -> list[Any]:
@@ -114,19 +135,23 @@ def map_in_processes(fn: Callable[..., Any], arg_tuples: Sequence[tuple], n_work
         A worker process died.
     """
     # Limit BLAS threads in the parent too: forked children inherit its pools.
-    with threadpool_limits(limits=1):
+    with threadpool_limits(limits=1), _sigint_deferred() as interrupted:
         pool = ProcessPoolExecutor(max_workers=n_workers, mp_context=mp_context(),
                                    initializer=_worker_init, initargs=(os.getpid(),))
         try:
             futures: list[Future] = [pool.submit(fn, *args) for args in arg_tuples]
             pending = set(futures)
             while pending:
+                if interrupted():
+                    raise KeyboardInterrupt
                 finished, pending = wait(pending, timeout=POLL_S, return_when=FIRST_COMPLETED)
                 for fut in finished:
                     if on_result is not None:
                         on_result(fut.result())
                 if should_stop is not None and should_stop():
                     raise WorkersStopped('stopped on request; worker processes ended')
+            if interrupted():
+                raise KeyboardInterrupt
             results = [f.result() for f in futures]
         except BrokenProcessPool as exc:
             _end(pool)
