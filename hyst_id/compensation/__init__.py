@@ -16,7 +16,9 @@
 
 :mod:`.inverse` holds :class:`InverseModel` (a validated parameter set),
 :class:`CommandLimits` and :class:`Compensator` (B⁻¹ then H⁻¹ with its own
-model state, atomic swaps).
+model state, atomic swaps). :mod:`.tracking` wraps it in an
+:class:`~hyst_id.compensation.tracking.AdaptiveCompensator` that tracks the
+plant's slow gain and offset from its measurement.
 
 May import: :mod:`hyst_id.models`, :mod:`hyst_id.errors`.
 """
