@@ -30,6 +30,14 @@ publishes it (generation, first sample it applies to, the full set and
 limits, where it came from) on the latched ``~/active_set`` topic
 (std_msgs/String JSON), so which set produced which command can be checked.
 
+With ``tracking.enabled`` the node also subscribes to its channel's
+measurement topic and tracks the plant's slow gain and offset against the
+model's prediction (:mod:`hyst_id.compensation.tracking`; a supply running
+down, a drifting gain or sensor offset), correcting the desired value by
+them; every change of the tracker's state is logged with its reason and the
+estimate is on ``/diagnostics``. The sensor parameters come from
+``tracking.*`` or from the identified-parameters topic.
+
 Commands are published reliable keep-all (:data:`hyst_id.nodes.COMMAND_QOS`):
 a command the middleware refuses (a subscriber stalled for seconds) is
 counted and reported on ``/diagnostics`` (ERROR), never dropped silently.
@@ -58,6 +66,7 @@ from hyst_id.models.registry import DEFAULT_FAMILY, FAMILIES, get_family
 from hyst_id.nodes.support import (
     COMMAND_QOS,
     DESIRED_TOPIC,
+    field_params,
     HystNode,
     IDENTIFIED_PARAMS_TOPIC,
     LATCHED_QOS,
@@ -65,10 +74,12 @@ from hyst_id.nodes.support import (
     Param,
     resolved,
     spin_node,
+    TOPIC_KEYS,
     topic_params,
     try_publish,
     type_mismatches,
 )
+from hyst_id.nodes.support.tracking import SENSOR_KEYS, TRACKING_PARAMS, TrackingLink
 
 try:  # optional: std_srvs is not a dependency of the package
     from std_srvs.srv import SetBool, Trigger
@@ -80,6 +91,7 @@ __all__ = ['ACTIVE_SET_QOS', 'Compensator', 'PARAMS', 'main']
 _NAN = math.nan
 _MODEL_KEYS = set(ALL_MODEL_NAMES) | {'output_sign', 'family'}
 _LIMIT_KEYS = {'min_command', 'max_command', 'max_rate_per_s'}
+SENSOR_NAMES = tuple(k for keys in SENSOR_KEYS.values() for k in keys)
 #: ``~/active_set``: every generation, late joiners get the last 100.
 ACTIVE_SET_QOS = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE,
                             durability=DurabilityPolicy.TRANSIENT_LOCAL)
@@ -123,7 +135,9 @@ PARAMS = [
           'last command) instead of passing the desired value through, and report ERROR'),
     Param('diagnostics_period_s', 1.0, 'period of the /diagnostics status', low=0.05,
           high=3600.0, unit='s'),
-    *topic_params(('command_topic',)),
+    *topic_params(TOPIC_KEYS),
+    *field_params(),
+    *TRACKING_PARAMS,
     Param('topics.desired_topic', DESIRED_TOPIC, 'desired output topic (std_msgs/Float64)',
           read_only=True),
     Param('topics.identified_params_topic', IDENTIFIED_PARAMS_TOPIC,
@@ -162,6 +176,8 @@ class Compensator(HystNode):
         if model is not None:
             warm_up(model)
         self._comp = CoreCompensator(model, _limits(values), v0=values['initial_command'])
+        self._tracking = TrackingLink(self)
+        self._tracking.configure(values, self._comp)
         self._source = 'params' if model is not None else ''
         self._n = 0
         self._not_sent = 0
@@ -203,6 +219,9 @@ class Compensator(HystNode):
         if not values['min_command'] < values['max_command']:
             return (f'min_command ({values["min_command"]:g}) must be < max_command '
                     f'({values["max_command"]:g})')
+        tracking = TrackingLink.validate(values)
+        if tracking:
+            return tracking
         if values['output_sign'] not in (1.0, -1.0):
             return f'output_sign must be 1.0 or -1.0; got {values["output_sign"]!r}'
         er = values['er_percent']
@@ -242,6 +261,9 @@ class Compensator(HystNode):
                                                  self._publish_status)
         source = self._source_hint or 'set_parameters'
         self._source_hint = ''
+        if any(n.startswith('tracking.') for n in changed) or (
+                'channel' in changed and self._tracking.adaptive is not None):
+            self._tracking.configure(values, self._comp)
         if changed & _MODEL_KEYS:
             kind, model, unset = _model_state(values)
             if model is None or model != self._comp.model:
@@ -296,6 +318,9 @@ class Compensator(HystNode):
         t0 = time.perf_counter_ns()
         if self._comp.model is None and self.p('require_model'):
             v = self._comp.state[0]           # hold: no model, no pass-through
+        elif self._tracking.adaptive is not None and self._comp.model is not None \
+                and not self._comp.bypass:
+            v = self._tracking.step(float(msg.data), t_s)
         else:
             v = self._comp.step(float(msg.data), t_s)
         self._step_ns.append(time.perf_counter_ns() - t0)
@@ -360,6 +385,8 @@ class Compensator(HystNode):
             values['family'] = family
             values['output_sign'] = float(doc.get('output_sign', params.get('output_sign', 1.0)))
             er = float(doc.get('compensator_er_percent', doc.get('er_percent', _NAN)))
+            full = doc.get('params') if isinstance(doc.get('params'), dict) else {}
+            values.update({f'tracking.{k}': float(full[k]) for k in SENSOR_NAMES if k in full})
         except (ValueError, TypeError, KeyError, AttributeError) as exc:
             log.warning(f'ignored identified parameters: not the expected JSON ({exc})')
             return
@@ -387,7 +414,7 @@ class Compensator(HystNode):
                   'er_percent': self.p('er_percent'), 'command': self._comp.state[0],
                   'generation': self._generation, 'rejected_updates': self.rejected_updates,
                   'bypass': self._comp.bypass,
-                  'commands_not_sent': self._not_sent}
+                  'commands_not_sent': self._not_sent, **self._tracking.status()}
         wrong = type_mismatches(self, self.p('topics.desired_topic'), 'std_msgs/msg/Float64')
         if wrong:
             text = (f'{resolved(self, self.p("topics.desired_topic"))}: {", ".join(wrong)}, '

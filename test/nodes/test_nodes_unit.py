@@ -109,9 +109,10 @@ def test_defaults_match_the_params_files():
                  'recorder', 'replay'):
         mod = importlib.import_module(f'hyst_id.nodes.{name}')
         doc = yaml.safe_load((root / f'{name}.yaml').read_text())['/**']['ros__parameters']
-        nested = doc.get('topics') if isinstance(doc.get('topics'), dict) else {}
-        flat = {k: v for k, v in doc.items() if not (k == 'topics' and nested)}
-        flat.update({f'topics.{k}': v for k, v in nested.items()})
+        flat = {k: v for k, v in doc.items() if not isinstance(v, dict)}
+        for group, nested in doc.items():        # topics:, tracking:, ...
+            if isinstance(nested, dict):
+                flat.update({f'{group}.{k}': v for k, v in nested.items()})
         table = {p.name: p.default for p in mod.PARAMS}
         assert set(flat) == set(table), name
         for key, default in table.items():
