@@ -48,7 +48,8 @@ setup(
     ],
     extras_require={
         'ros': ['ros-rclpy', 'ros-std-msgs', 'ros-std-srvs', 'ros-sensor-msgs',
-                'ros-diagnostic-msgs', 'ros-rcl-interfaces', 'ros-rmw-fastrtps-cpp'],
+                'ros-diagnostic-msgs', 'ros-rcl-interfaces', 'ros-rosgraph-msgs',
+                'ros-builtin-interfaces', 'ros-rmw-fastrtps-cpp'],
         'test': ['pytest>=7', 'pytest-xdist>=3', 'flake8>=6', 'flake8-import-order',
                  'flake8-quotes',
                  'flake8-builtins', 'flake8-comprehensions', 'pydocstyle>=6',

@@ -191,8 +191,8 @@ class Compensator(HystNode):
                                  COMMAND_QOS, qos_overriding_options=OVERRIDABLE)
         self.create_subscription(String, self.p('topics.identified_params_topic'),
                                  self._on_identified, LATCHED_QOS)
-        self._diag_timer = self.create_timer(values['diagnostics_period_s'],
-                                             self._publish_status)
+        self._diag_timer = self.create_steady_timer(values['diagnostics_period_s'],
+                                                    self._publish_status)
         if SetBool is not None:
             self.create_service(SetBool, '~/bypass', self._on_bypass)
             self.create_service(Trigger, '~/reset', self._on_reset)
@@ -257,8 +257,8 @@ class Compensator(HystNode):
         if 'diagnostics_period_s' in changed:
             self._diag_timer.cancel()
             self.destroy_timer(self._diag_timer)
-            self._diag_timer = self.create_timer(values['diagnostics_period_s'],
-                                                 self._publish_status)
+            self._diag_timer = self.create_steady_timer(values['diagnostics_period_s'],
+                                                        self._publish_status)
         source = self._source_hint or 'set_parameters'
         self._source_hint = ''
         if any(n.startswith('tracking.') for n in changed) or (

@@ -143,8 +143,8 @@ class Excitation(HystNode):
         self.on_finished: Callable[[], None] | None = None
         #: ``ready(k)`` -> bool, asked before sample ``k`` goes out; False holds it.
         self.ready: Callable[[int], bool] | None = None
-        self.create_timer(1.0, self._status)
-        self.create_timer(0.02, self._wait_and_start)
+        self.create_steady_timer(1.0, self._status)
+        self.create_steady_timer(0.02, self._wait_and_start)
 
     # ---------------------------------------------------------------- params
     def validate_params(self, values: dict[str, Any], changed: set[str]) -> str | None:

@@ -160,8 +160,8 @@ class Identifier(HystNode):
                                     lambda req, res, fn=fn: self._on_trigger(fn, res))
         self._warm = ThreadPoolExecutor(max_workers=1, thread_name_prefix='jit-warm-up')
         self._warm_future = self._warm.submit(warm_up_kernels, self.channel)
-        self.create_timer(0.02, self._tick)
-        self.create_timer(1.0, self._status)
+        self.create_steady_timer(0.02, self._tick)
+        self.create_steady_timer(1.0, self._status)
         self.get_logger().info(
             f'identifying {self.channel} from {resolved(self, v["topics.command_topic"])} + '
             f'{resolved(self, self._meas_topic)} ({meas_type} '

@@ -126,9 +126,9 @@ class Recorder(HystNode):
                                  chunk_span_s=self.p('chunk_span_s')).open()
         self._subs: dict[str, Any] = {}
         self.counts: dict[str, int] = {}
-        self.create_timer(self.p('discovery_period_s'), self._discover)
-        self.create_timer(self.p('flush_period_s'), self._flush)
-        self.create_timer(1.0, self._status)
+        self.create_steady_timer(self.p('discovery_period_s'), self._discover)
+        self.create_steady_timer(self.p('flush_period_s'), self._flush)
+        self.create_steady_timer(1.0, self._status)
         self.get_logger().info(f'recording {len(self._wanted)} topic(s) to {self.path}: '
                                f'{", ".join(self._wanted)}')
         self._discover()

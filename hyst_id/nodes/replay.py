@@ -17,7 +17,15 @@
 Messages are read with :func:`hyst_id.io.bag.iter_bag_messages`, serialised
 again (CDR) and published in log-time order from a background thread, each
 ``(log_time - first_log_time) / rate`` after the start; header stamps are
-left as recorded. Publishers are reliable (depth 1000) so they match both
+left as recorded. With ``publish_clock`` (the default) the bag's log time of
+each message is published on ``/clock`` (rosgraph_msgs/Clock) just before the
+message, so that nodes started with ``use_sim_time:=true`` time unstamped
+messages (Float64 commands, flow) in the bag's time at any ``rate``; without
+it a subscriber timing them by arrival sees time ``rate`` times faster (a
+pressure sensor's 1.4 s lag identified as 0.34 s at rate 4). The clock and
+the message travel on two topics, so a subscriber may take a message before
+its clock tick: its time is then the previous message's, at most one
+sample period early. Publishers are reliable (depth 1000) so they match both
 reliable and best-effort subscribers; the identified-parameters topic is
 also transient local. A bag that cannot be read ends the process with a
 one-line error and exit code 2.
@@ -30,7 +38,9 @@ import threading
 import time
 from typing import Any
 
+from builtin_interfaces.msg import Time
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+from rosgraph_msgs.msg import Clock
 
 from hyst_id.errors import ConfigError, HystIdError, RecordingError
 from hyst_id.io.bag import default_typestore, iter_bag_messages, open_bag
@@ -59,6 +69,8 @@ PARAMS = [
           'killed', read_only=True),
     Param('shutdown_when_done', True, 'exit the process when the bag is played',
           read_only=True),
+    Param('publish_clock', True, "publish the bag's log time on /clock before each message "
+          '(for nodes with use_sim_time)', read_only=True),
 ]
 
 
@@ -98,6 +110,8 @@ class Replay(HystNode):
             self._pubs[topic] = self.create_publisher(cls, topic, _qos(topic, topic in latched))
         if not self._pubs:
             raise RecordingError(f'{self.path}: no playable topics')
+        self._clock_pub = (self.create_publisher(Clock, '/clock', _qos('/clock'))
+                           if self.p('publish_clock') else None)
         self.published = 0
         self.exit_code = 0
         self.done = threading.Event()
@@ -107,7 +121,7 @@ class Replay(HystNode):
                 f'{t} ({counts.get(t, 0)})' for t in self._pubs))
         self._thread = threading.Thread(target=self._run, name='replay', daemon=True)
         self._thread.start()
-        self.create_timer(0.1, self._check_done)
+        self.create_steady_timer(0.1, self._check_done)
 
     def _wait_for_subscribers(self) -> None:
         need = self.p('wait_for_subscribers')
@@ -139,6 +153,9 @@ class Replay(HystNode):
                 delay = t0_wall + (t_ns - t0_bag) * 1e-9 / rate - time.monotonic()
                 if delay > 0 and self._stop.wait(delay):
                     return
+                if self._clock_pub is not None:
+                    self._clock_pub.publish(Clock(clock=Time(sec=t_ns // 1_000_000_000,
+                                                             nanosec=t_ns % 1_000_000_000)))
                 data = self._typestore.serialize_cdr(msg, msgtype)
                 self._pubs[topic].publish(bytes(data))
                 self.published += 1

@@ -233,3 +233,36 @@ def test_diagnose_service_publishes_findings_and_json(ctx):
     assert float(values['er_holdout_after_percent']) < float(values['er_holdout_before_percent'])
     assert 'param.rate_per_s' in values and values['mechanism'] == 'offset_drift'
     assert ident.buffer.n_measurements == 400                 # diagnosing keeps the samples
+
+
+@pytest.mark.slow
+def test_replay_at_rate_4_with_sim_time_keeps_the_sensor_time_constant(ctx, tmp_path):
+    """Pressure (header-stamped) and commands (unstamped) replayed 4x fast, use_sim_time.
+
+    The recording comes from the independent reference simulator (tau 1.5 s).
+    Before /clock the commands were timed by arrival and tau came out near 1.5 / 4.
+    """
+    from reference_sim import simulate
+
+    from hyst_id.io.bag import write_recording_bag
+    from hyst_id.io.recording import Recording
+    from hyst_id.nodes.replay import Replay
+
+    t = np.arange(900) * 0.1
+    v = eq24(t)
+    y = simulate('pressure', {**PAPER, 'tau_s': 1.5}, t, v, gain=-40_000.0, offset=600_000.0)
+    y = y + np.random.default_rng(5).normal(0, 100.0, t.size)
+    bag = write_recording_bag(tmp_path / 'p', Recording(t, v, y, 'pressure', 'mA', 'Pa'))
+    got = _listen(ctx)
+    _make(ctx, Identifier, parameter_overrides=[
+        Parameter('channel', value='pressure'), Parameter('use_sim_time', value=True),
+        Parameter('seeds', value=2), Parameter('generations', value=60),
+        Parameter('end_of_run_timeout_s', value=1.0), Parameter('compensator_node', value=''),
+        Parameter('measurement_reliable', value=True), Parameter('recover_on_start', value=False),
+        Parameter('params_out', value=str(tmp_path / 'out.yaml'))])
+    _make(ctx, Replay, parameter_overrides=[
+        Parameter('bag', value=str(bag)), Parameter('rate', value=4.0),
+        Parameter('wait_for_subscribers', value=2), Parameter('shutdown_when_done', value=False)])
+    assert _spin_until(ctx, lambda: bool(got), timeout=150.0)
+    assert got[-1]['n_samples'] >= 890
+    assert got[-1]['params']['tau_s'] == pytest.approx(1.5, rel=0.15), got[-1]['params']

@@ -469,3 +469,29 @@ def test_control_error_percent_is_eq26():
     assert control_error_percent([1.0, 2.0], [1.0, 2.0]) == 0.0
     assert control_error_percent([1.1, 2.0], [1.0, 2.0]) == pytest.approx(
         100 * math.sqrt(0.01 / 5.0))
+
+
+@pytest.mark.parametrize('sim_time', [True, False])
+def test_replay_clock_keeps_bag_time_at_any_rate(ctx, tmp_path, sim_time):
+    """Unstamped commands replayed at rate 4 keep their 0.1 s spacing for a sim-time node."""
+    t = np.arange(60) * 0.1
+    bag = write_recording_bag(tmp_path / 'src', Recording(t, 9 + np.sin(t), t, 'position'))
+    rec = _make(ctx, Recorder, parameter_overrides=[
+        Parameter('output', value=str(tmp_path / 'rec')),
+        Parameter('use_sim_time', value=sim_time),
+        Parameter('topics', value=['/hyst_id/command'])])
+    play = _make(ctx, Replay, parameter_overrides=[
+        Parameter('bag', value=str(bag)), Parameter('rate', value=4.0),
+        Parameter('topics', value=['/hyst_id/command']),
+        Parameter('wait_for_subscribers', value=1), Parameter('shutdown_when_done', value=False)])
+    _spin_until(ctx, [rec, play], lambda: rec.counts.get('/hyst_id/command') == 60,
+                timeout=20.0)
+    assert rec.counts.get('/hyst_id/command') == 60, (rec.counts, play.published)
+    rec.close()
+    stamps = np.array([t_ns for _, _, t_ns, _ in iter_bag_messages(tmp_path / 'rec')]) * 1e-9
+    spacing = float(np.median(np.diff(stamps)))
+    if sim_time:     # the bag's time (a message may take the previous clock tick: one sample)
+        assert spacing == pytest.approx(0.1, abs=0.01)
+        assert stamps[-1] - stamps[0] == pytest.approx(5.9, abs=0.25)
+    else:            # arrival time: four times faster
+        assert spacing == pytest.approx(0.025, abs=0.01)

@@ -20,6 +20,7 @@ from typing import Any, Iterable, Mapping, Sequence
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from rcl_interfaces.msg import SetParametersResult
+from rclpy.clock import Clock, ClockType
 from rclpy.exceptions import (
     InvalidParameterTypeException,
     InvalidParameterValueException,
@@ -81,6 +82,10 @@ class HystNode(Node):
     parameter matches (:func:`unknown_overrides`) is logged as an error and
     reported every second on ``/diagnostics`` (ERROR, status
     ``hyst_id: <node>: parameters``) for the node's life: it was ignored.
+
+    Housekeeping timers (status, discovery, end-of-run detection) are made
+    with :meth:`create_steady_timer`: under ``use_sim_time`` a ROS-time timer
+    stands still until ``/clock`` moves and again after a replay ends.
     """
 
     def __init__(self, node_name: str, params: Sequence[Param],
@@ -116,6 +121,12 @@ class HystNode(Node):
         if report_unknown:
             self.report_unknown_parameters()
 
+    def create_steady_timer(self, period_s: float, callback: Any) -> Any:
+        """A timer on the steady (wall) clock, whatever ``use_sim_time`` says."""
+        if not hasattr(self, '_steady_clock'):
+            self._steady_clock = Clock(clock_type=ClockType.STEADY_TIME)
+        return self.create_timer(period_s, callback, clock=self._steady_clock)
+
     def report_unknown_parameters(self, declared: Iterable[str] | None = None) -> list[str]:
         """Find, log (ERROR) and keep reporting overrides no parameter matches.
 
@@ -132,7 +143,7 @@ class HystNode(Node):
                 f'or a key of another node?); {self.get_name()} declares: '
                 + ', '.join(sorted(n for n in self._param_table if not n.startswith('topics.'))))
             self.get_logger().error(self._unknown_message)
-            self.create_timer(1.0, self._report_unknown)
+            self.create_steady_timer(1.0, self._report_unknown)
         return self.unknown_parameters
 
     # --------------------------------------------------------------- params

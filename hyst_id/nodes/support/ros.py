@@ -30,6 +30,7 @@ from typing import Any, Callable, Iterator, Mapping
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 import rclpy
+from rclpy.exceptions import ParameterNotDeclaredException
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.node import Node
@@ -86,9 +87,23 @@ def try_publish(publisher: Any, msg: Any) -> bool:
 
 
 def source_time_ns(node: Node, info: Mapping[str, Any]) -> int:
-    """A message's source timestamp (from the middleware), else its receive time, else now."""
+    """When an unstamped message was sent.
+
+    With ``use_sim_time`` (a replay publishing ``/clock``) the node's ROS
+    clock, i.e. the bag's time; otherwise the middleware's source timestamp,
+    else the receive time, else now.
+    """
+    if _uses_sim_time(node):
+        return node.get_clock().now().nanoseconds
     return int(info.get('source_timestamp') or 0) or int(
         info.get('received_timestamp') or 0) or node.get_clock().now().nanoseconds
+
+
+def _uses_sim_time(node: Node) -> bool:
+    try:
+        return bool(node.get_parameter('use_sim_time').value)
+    except ParameterNotDeclaredException:   # pragma: no cover - rclpy always declares it
+        return False
 
 
 #: Longest wait of the spin loop between two looks at the stop flag [s].
