@@ -74,9 +74,36 @@ class SampleBuffer:
         """Measurements collected."""
         return len(self.meas_t)
 
+    @property
+    def span_s(self) -> float:
+        """Time from the first to the last measurement kept, seconds (0 when < 2).
+
+        From the ends of the stream as it arrived (cheap; samples arrive
+        nearly in order), not from a sort.
+        """
+        if len(self.meas_t) < 2:
+            return 0.0
+        return abs(self.meas_t[-1] - self.meas_t[0]) * 1e-9
+
     def recording(self, channel: str, source: str = '', units: tuple[str, str] = ('', ''),
-                  names: tuple[str, str] = ('command', 'measurement')) -> Recording:
-        """The run so far as a Recording (see :func:`pair_streams`)."""
-        return pair_streams(np.array(self.cmd_t, dtype=np.int64), np.array(self.cmd_v),
-                            np.array(self.meas_t, dtype=np.int64), np.array(self.meas_v),
-                            channel, source, units, names)
+                  names: tuple[str, str] = ('command', 'measurement'),
+                  last_s: float | None = None) -> Recording:
+        """The run so far as a Recording (see :func:`pair_streams`).
+
+        With ``last_s`` only the measurements of the newest ``last_s`` seconds
+        (and the commands from then on, with the one in effect at its start)
+        are paired: a sliding window costs its own length, not the whole
+        buffer's.
+        """
+        ct, cv = np.array(self.cmd_t, dtype=np.int64), np.array(self.cmd_v)
+        mt, mv = np.array(self.meas_t, dtype=np.int64), np.array(self.meas_v)
+        if last_s is not None and mt.size:
+            since = int(mt.max() - last_s * 1e9)
+            keep = mt >= since
+            mt, mv = mt[keep], mv[keep]
+            lead = ct >= since
+            before = np.flatnonzero(~lead)
+            if before.size:                 # the command in effect when the window opens
+                lead[before[np.argmax(ct[before])]] = True
+            ct, cv = ct[lead], cv[lead]
+        return pair_streams(ct, cv, mt, mv, channel, source, units, names)

@@ -17,7 +17,9 @@
 :class:`BackgroundJob` runs :meth:`~BackgroundJob.work` in a daemon thread and
 keeps its result or a one-line error; :class:`IdentificationJob` and
 :class:`DiagnosisJob` call :func:`hyst_id.identification.identify` /
-:func:`hyst_id.diagnosis.diagnose` with progress a node can publish.
+:func:`hyst_id.diagnosis.diagnose` with progress a node can publish;
+:class:`SlidingJob` re-identifies a sliding window and decides a swap
+(:func:`hyst_id.live.sliding.reidentify_window`).
 """
 
 from __future__ import annotations
@@ -32,7 +34,7 @@ from hyst_id.identification.chains import ChainSpec
 from hyst_id.identification.model_choice import choose_family, ModelChoice
 from hyst_id.io.recording import Recording
 
-__all__ = ['BackgroundJob', 'DiagnosisJob', 'IdentificationJob', 'JobCancelled']
+__all__ = ['BackgroundJob', 'DiagnosisJob', 'IdentificationJob', 'JobCancelled', 'SlidingJob']
 
 
 class JobCancelled(HystIdError):
@@ -215,3 +217,25 @@ class DiagnosisJob(BackgroundJob):
     def _progress(self, message: str) -> None:
         self.step = str(message)
         self.check_cancelled()
+
+
+class SlidingJob(BackgroundJob):
+    """:func:`hyst_id.live.sliding.reidentify_window` in a worker thread.
+
+    ``result`` is the :class:`~hyst_id.live.sliding.SwapDecision`; ``kwargs``
+    go to ``reidentify_window`` (``rule``, ``gate``, ``fresh_settings``). The
+    fresh identification runs its seeds in this thread, so a cancel stops it
+    within a generation.
+    """
+
+    name = 'sliding'
+
+    def __init__(self, current: Identification, window: Recording, **kwargs: Any) -> None:
+        super().__init__()
+        self.current, self.window, self.kwargs = current, window, kwargs
+        self.start()
+
+    def work(self) -> Any:
+        from hyst_id.live.sliding import reidentify_window
+        return reidentify_window(self.current, self.window, should_stop=self._cancel.is_set,
+                                 **self.kwargs)

@@ -68,6 +68,7 @@ from hyst_id.nodes.support import (
     COMMAND_QOS,
     diagnostic_array,
     HystNode,
+    input_problems,
     LATCHED_QOS,
     message_class,
     OVERRIDABLE,
@@ -76,9 +77,9 @@ from hyst_id.nodes.support import (
     source_time_ns,
     spin_node,
     stamp_ns,
-    type_mismatches,
 )
 from hyst_id.nodes.support.identifier_params import PARAMS
+from hyst_id.nodes.support.sliding import SlidingLink
 
 try:  # optional: std_srvs is not a dependency of the package
     from std_srvs.srv import Trigger
@@ -121,6 +122,7 @@ class Identifier(HystNode):
         self._eor_tried = False
         self._requested: set[str] = set()
         self._pusher = ParameterPusher(self)
+        self.sliding = SlidingLink(self)
         self._started = time.monotonic()
         #: monotonic time each input stream was last received (not reset by a new run).
         self._rx: dict[str, float] = {}
@@ -182,6 +184,8 @@ class Identifier(HystNode):
             return "model 'auto' derives each family's domains from the data: domains must be auto"
         if {'domains', 'model'} & changed and dom == 'paper' and values['model'] != 'tk':
             return f"the 'paper' domains are for model 'tk', not {values['model']!r}"
+        if any(n.startswith('sliding.') for n in changed):
+            return SlidingLink.validate(values)
         return None
 
     def apply_params(self, values: dict[str, Any], changed: set[str]) -> None:
@@ -220,10 +224,11 @@ class Identifier(HystNode):
         response.success, response.message = fn('service call')
         return response
 
-    def _recording(self) -> Recording:
+    def collected_recording(self, last_s: float | None = None) -> Recording:
+        """The samples collected (the newest ``last_s`` seconds of them) as a Recording."""
         return self.buffer.recording(
             self.channel, f'live: {self.p("topics.command_topic")}, {self._meas_topic}',
-            self._units, (self.p('topics.command_topic'), self._meas_topic))
+            self._units, (self.p('topics.command_topic'), self._meas_topic), last_s=last_s)
 
     def _busy(self) -> str:
         if any(not j.done for j in self._cancelled):
@@ -240,7 +245,7 @@ class Identifier(HystNode):
         if self._busy():
             return False, self._busy()
         try:
-            rec = validate_recording(self._recording())
+            rec = validate_recording(self.collected_recording())
             model = self.p('model')
             if model == 'auto':
                 self.job = IdentificationJob(rec, None, self.settings(), families=AUTO_FAMILIES)
@@ -284,7 +289,7 @@ class Identifier(HystNode):
             return False, self._busy()
         try:
             if self.buffer.n_measurements >= self.p('min_samples'):
-                rec, what = self._recording(), 'the samples collected'
+                rec, what = self.collected_recording(), 'the samples collected'
             elif self._last_rec is not None:
                 rec, what = self._last_rec, 'the last identified run'
             else:
@@ -346,41 +351,52 @@ class Identifier(HystNode):
             if job.error:
                 self._fail(f'identification failed: {job.error}; {self._kept()}')
             elif job.result is not None:
-                self._publish_result(job)
+                self.publish_identified(job.result, job.rec, job.elapsed_s, job.choice)
         if self.diag_job is not None and self.diag_job.done:
             job, self.diag_job = self.diag_job, None
             if job.error:
                 self._fail(f'diagnosis failed: {job.error}')
             elif job.result is not None:
                 self._publish_diagnosis(job.result.to_dict(), job.elapsed_s)
+        self.sliding.tick()
         self._pusher.poll()
 
-    def _publish_result(self, job: IdentificationJob) -> None:
-        ident = job.result
+    def quality_gate(self) -> QualityGate:
+        """The gate a set must pass to be handed over (from the ``gate_*`` parameters)."""
+        return QualityGate(self.p('gate_max_floor_ratio'), self.p('gate_max_uncertainty'))
+
+    def publish_identified(self, ident: Identification, rec: Recording, elapsed_s: float,
+                           choice: Any = None, sliding: dict | None = None) -> None:
+        """Publish an identified set and hand it over (params file, compensator) if it may be.
+
+        ``sliding`` (a swap decision, JSON-ready) marks a set from a
+        sliding-window re-identification; it goes into the document.
+        """
         self.last_identification = ident
-        self._last_rec = job.rec
-        gate = QualityGate(self.p('gate_max_floor_ratio'), self.p('gate_max_uncertainty'))
-        doc = result_document(ident, job.rec.n_samples, job.rec.duration_s, job.rec.notes,
-                              gate=gate)
+        self._last_rec = rec
+        doc = result_document(ident, rec.n_samples, rec.duration_s, rec.notes,
+                              gate=self.quality_gate())
+        if sliding is not None:
+            doc['sliding'] = sliding
         comp = doc['compensator_params']
         if comp is None and not doc['gate']['passed']:
-            self._publish_held_back(job, doc)
+            self._publish_held_back(ident, rec, doc)
             return
         if comp is None:
             self._fail(f'identified {ident.channel} (%e_r {ident.er_percent:.3f}) but '
                        f'{doc["compensator_note"]}; {self._kept()}')
             return
-        if job.choice is not None:
-            doc['model_choice'] = job.choice.to_dict()
+        if choice is not None:
+            doc['model_choice'] = choice.to_dict()
             self.get_logger().info('H family chosen on held-out data: ' + ', '.join(
-                f'{c.family} {c.holdout_er_percent:.4f} %' for c in job.choice.scores)
-                + f' -> {job.choice.chosen}')
+                f'{c.family} {c.holdout_er_percent:.4f} %' for c in choice.scores)
+                + f' -> {choice.chosen}')
         self.last_document = doc
         self.last_error = ''
         self._gate_message = ''
         self._result_pub.publish(String(data=json.dumps(doc)))
         self.get_logger().info(
-            f'identified {ident.channel} in {job.elapsed_s:.1f} s: %e_r '
+            f'identified {ident.channel} in {elapsed_s:.1f} s: %e_r '
             f'{ident.er_percent:.3f} (noise floor {ident.noise_floor_percent:.3f}); '
             + ', '.join(f'{n}={ident.params[n]:.4g}' for n in ident.names))
         for w in ident.warnings:
@@ -389,7 +405,7 @@ class Identifier(HystNode):
                                  f'identified {ident.channel}: %e_r {ident.er_percent:.3f}'
                                  + (f'; {len(ident.warnings)} warning(s): '
                                     + ' | '.join(ident.warnings) if ident.warnings else ''),
-                                 {'er_percent': ident.er_percent, 'elapsed_s': job.elapsed_s})
+                                 {'er_percent': ident.er_percent, 'elapsed_s': elapsed_s})
         values = compensator_values({**comp, 'channel': ident.channel,
                                      'er_percent': doc['compensator_er_percent']})
         try:
@@ -404,11 +420,8 @@ class Identifier(HystNode):
         if self.on_identified is not None:
             self.on_identified(doc)
 
-    def _publish_held_back(self, job: IdentificationJob, doc: dict) -> None:
+    def _publish_held_back(self, ident: Identification, rec: Recording, doc: dict) -> None:
         """Publish a result the quality gate holds back: nothing is handed over."""
-        ident = job.result
-        self.last_identification = ident
-        self._last_rec = job.rec
         self.last_document = doc
         self.last_error = ''
         self._result_pub.publish(String(data=json.dumps(doc)))
@@ -425,20 +438,9 @@ class Identifier(HystNode):
 
     def _input_problems(self) -> list[str]:
         """Inputs of a wrong type, or one input arriving while the other does not."""
-        out = []
-        for topic, expected in self._expected:
-            for m in type_mismatches(self, topic, expected):
-                out.append(f'{resolved(self, topic)}: {m}, expected {expected} (never '
-                           'received)')
-        now, tmo = time.monotonic(), self.p('input_timeout_s')
-        if now - self._started > tmo:
-            live = {k for k, t in self._rx.items() if now - t < tmo}
-            topics = {'command': self.p('topics.command_topic'), 'measurement': self._meas_topic}
-            for have, lack in (('command', 'measurement'), ('measurement', 'command')):
-                if have in live and lack not in live:
-                    out.append(f'{have}s arrive on {resolved(self, topics[have])} but no '
-                               f'{lack} on {resolved(self, topics[lack])} for {tmo:g} s')
-        return out
+        return input_problems(
+            self, self._expected, self._rx, self._started, self.p('input_timeout_s'),
+            {'command': self.p('topics.command_topic'), 'measurement': self._meas_topic})
 
     def _publish_diagnosis(self, doc: dict, elapsed_s: float) -> None:
         self.last_diagnosis = doc
@@ -487,6 +489,7 @@ class Identifier(HystNode):
             level, msg = 1, self._gate_message
         elif self.last_document:
             values['last_er_percent'] = self.last_document.get('er_percent') or math.nan
+        values.update(self.sliding.status())
         problems = self._input_problems()
         if problems:
             level, msg = 2, '; '.join(problems) + f' ({msg})'
@@ -497,7 +500,8 @@ class Identifier(HystNode):
         """Stop workers, then the node."""
         if hasattr(self, '_warm'):    # also called on a node whose __init__ failed
             self._warm.shutdown(wait=False, cancel_futures=True)
-            jobs = [j for j in (self.job, self.diag_job, *self._cancelled) if j is not None]
+            jobs = [j for j in (self.job, self.diag_job, self.sliding.cancel(), *self._cancelled)
+                    if j is not None]
             for job in jobs:
                 job.cancel()
             for job in jobs:        # worker processes end within 0.2 s of a cancel

@@ -19,6 +19,7 @@ from __future__ import annotations
 from hyst_id.io.recording import CHANNELS
 from hyst_id.nodes.support.params import field_params, Param, topic_params
 from hyst_id.nodes.support.qos import IDENTIFIED_PARAMS_TOPIC
+from hyst_id.nodes.support.sliding import SLIDING_PARAMS
 
 __all__ = ['PARAMS']
 
@@ -86,4 +87,5 @@ PARAMS = [
           'held out)', low=0.1, high=0.95),
     Param('diagnose_mechanisms', '', "comma-separated mechanism ids to test ('' = the whole "
           'library)'),
+    *SLIDING_PARAMS,
 ]

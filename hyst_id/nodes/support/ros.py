@@ -26,7 +26,8 @@ import importlib
 import signal
 import sys
 import threading
-from typing import Any, Callable, Iterator, Mapping
+import time
+from typing import Any, Callable, Iterator, Mapping, Sequence
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 import rclpy
@@ -39,8 +40,9 @@ from rclpy.signals import SignalHandlerOptions
 from hyst_id.errors import ConfigError, HystIdError
 
 __all__ = ['EXIT_SIGINT', 'diagnostic_array', 'exit_code_after', 'first_line', 'init_ros',
-           'message_class', 'resolved', 'source_time_ns', 'spin_in_background', 'spin_node',
-           'spin_until_stopped', 'stamp_ns', 'stop_signals', 'try_publish', 'type_mismatches']
+           'input_problems', 'message_class', 'resolved', 'source_time_ns',
+           'spin_in_background', 'spin_node', 'spin_until_stopped', 'stamp_ns', 'stop_signals',
+           'try_publish', 'type_mismatches']
 
 _RCLError = _rclpy.RCLError
 
@@ -227,6 +229,28 @@ def type_mismatches(node: Node, topic: str, expected: str) -> list[str]:
         return []
     return sorted({f'{(i.node_namespace.rstrip("/") + "/" + i.node_name)} publishes '
                    f'{i.topic_type}' for i in infos if i.topic_type != expected})
+
+
+def input_problems(node: Node, expected: Sequence[tuple[str, str]], rx: Mapping[str, float],
+                   started: float, timeout_s: float, topics: Mapping[str, str]) -> list[str]:
+    """Inputs of a wrong type, or one of two inputs arriving while the other does not.
+
+    ``expected`` holds ``(topic, type)`` pairs; ``rx`` the monotonic time each
+    input (``'command'``, ``'measurement'``) was last received, ``started``
+    the node's start (monotonic) and ``topics`` each input's topic.
+    """
+    out = []
+    for topic, want in expected:
+        for m in type_mismatches(node, topic, want):
+            out.append(f'{resolved(node, topic)}: {m}, expected {want} (never received)')
+    now = time.monotonic()
+    if now - started > timeout_s:
+        live = {k for k, t in rx.items() if now - t < timeout_s}
+        for have, lack in (('command', 'measurement'), ('measurement', 'command')):
+            if have in live and lack not in live:
+                out.append(f'{have}s arrive on {resolved(node, topics[have])} but no '
+                           f'{lack} on {resolved(node, topics[lack])} for {timeout_s:g} s')
+    return out
 
 
 def resolved(node: Node, topic: str) -> str:
