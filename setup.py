@@ -21,7 +21,7 @@ from setuptools import find_packages, setup
 package_name = 'hyst_id'
 
 NODES = ['actuator_driver', 'pipeline_sim', 'excitation', 'identifier', 'compensator',
-         'recorder', 'replay', 'bringup']
+         'lifecycle_compensator', 'recorder', 'replay', 'bringup']
 
 setup(
     name=package_name,
@@ -49,7 +49,7 @@ setup(
     extras_require={
         'ros': ['ros-rclpy', 'ros-std-msgs', 'ros-std-srvs', 'ros-sensor-msgs',
                 'ros-diagnostic-msgs', 'ros-rcl-interfaces', 'ros-rosgraph-msgs',
-                'ros-builtin-interfaces', 'ros-rmw-fastrtps-cpp'],
+                'ros-builtin-interfaces', 'ros-lifecycle-msgs', 'ros-rmw-fastrtps-cpp'],
         'test': ['pytest>=7', 'pytest-xdist>=3', 'flake8>=6', 'flake8-import-order',
                  'flake8-quotes',
                  'flake8-builtins', 'flake8-comprehensions', 'pydocstyle>=6',

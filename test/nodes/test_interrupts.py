@@ -42,8 +42,8 @@ pytestmark = pytest.mark.ros
 DELAYS_S = (0.0, 0.03, 0.3)
 #: What each signal must give.
 EXPECTED_EXIT = {signal.SIGINT: 130, signal.SIGTERM: 0}
-NODES = ['compensator', 'actuator_driver', 'identifier', 'pipeline_sim', 'excitation',
-         'recorder', 'replay', 'bringup']
+NODES = ['compensator', 'lifecycle_compensator', 'actuator_driver', 'identifier',
+         'pipeline_sim', 'excitation', 'recorder', 'replay', 'bringup']
 
 
 def node_command(node: str, tmp_path) -> list[str]:
