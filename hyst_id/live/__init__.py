@@ -35,7 +35,8 @@ installation:
 
 Modules: :mod:`.buffer` (samples), :mod:`.jobs` (worker threads),
 :mod:`.documents` (what the node publishes), :mod:`.gate` (when a set is
-held back from the compensator).
+held back from the compensator), :mod:`.sliding` (re-identification on a
+sliding window of live data and the rule for swapping its set in).
 
 May import: :mod:`hyst_id.io`, :mod:`hyst_id.identification`, :mod:`hyst_id.compensation`,
 :mod:`hyst_id.diagnosis`; never rclpy.
