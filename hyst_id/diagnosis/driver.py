@@ -140,7 +140,9 @@ def finding_from(comp: Comparison, before: FitResult, mech: Mechanism, loc: Loca
                    er_train_after_percent=fit.er_train_percent,
                    er_holdout_before_percent=before.er_holdout_percent,
                    er_holdout_after_percent=fit.er_holdout_percent,
-                   delta_bic=comp.delta_bic, holdout_z=comp.holdout_z)
+                   delta_bic=comp.delta_bic, holdout_z=comp.holdout_z,
+                   compensation={'kind': mech.compensation,
+                                 'how': mech.compensation_note(values, ctx)})
 
 
 def diagnose(recording: Recording, *, spec: ChainSpec | None = None,

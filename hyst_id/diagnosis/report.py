@@ -82,6 +82,8 @@ def format_diagnosis(d: Any) -> str:
                      f'{_fmt(f.er_holdout_after_percent)} ({-gain:+.0f} %); training '
                      f'{_fmt(f.er_train_before_percent)} -> {_fmt(f.er_train_after_percent)}; '
                      f'delta BIC {f.delta_bic:.0f}, held-out z {f.holdout_z:.1f}')
+        if f.compensation:
+            lines.append(f'    compensation: {f.compensation["how"]}')
         if f.alternatives:
             alts = ', '.join(f'{a["mechanism"]} (held-out {a["er_holdout_after_percent"]:.4g})'
                              for a in f.alternatives)

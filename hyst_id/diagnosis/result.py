@@ -82,6 +82,9 @@ class Finding:
     delta_bic: float
     holdout_z: float
     alternatives: list = field(default_factory=list)
+    #: How the block is made up for in operation: ``{'kind': ..., 'how': words}``
+    #: (:data:`hyst_id.diagnosis.mechanisms.base.COMPENSATION_KINDS`).
+    compensation: dict = field(default_factory=dict)
 
     def to_dict(self) -> dict:
         """JSON-ready form."""
@@ -93,7 +96,8 @@ class Finding:
                 'er_holdout_before_percent': self.er_holdout_before_percent,
                 'er_holdout_after_percent': self.er_holdout_after_percent,
                 'delta_bic': self.delta_bic, 'holdout_z': self.holdout_z,
-                'alternatives': list(self.alternatives)}
+                'alternatives': list(self.alternatives),
+                'compensation': dict(self.compensation)}
 
 
 @dataclass
@@ -175,6 +179,8 @@ class Diagnosis:
         for f in self.findings:
             for name, q in f.params.items():
                 values[f'{f.mechanism}.{name}'] = f'{q.value:.4g} {q.unit}'.strip()
+            if f.compensation:
+                values[f'{f.mechanism}.compensation'] = f.compensation['kind']
         if self.verdict == 'unknown':
             return 'warn', ('something is missing that no mechanism of the library explains'
                             + (f': {self.empirical.summary()}' if self.empirical else '')), values

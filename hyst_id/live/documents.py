@@ -133,7 +133,8 @@ def diagnosis_statuses(doc: dict) -> list[tuple[int, str, str, dict[str, Any]]]:
     level 1 (WARN: the model lacks a mechanism) named after its mechanism,
     its explanation as message and, as values, the mechanism, its place in
     the chain, the held-out and training %e_r before and after adding it,
-    and its parameters (``name: value unit``). No finding gives one level 0
+    its parameters (``name: value unit``) and how the block is compensated
+    (``compensation``: kind, ``compensation_how``: words). No finding gives one level 0
     status with the verdict, the held-out %e_r and the noise floor.
     """
     out = []
@@ -152,6 +153,10 @@ def diagnosis_statuses(doc: dict) -> list[tuple[int, str, str, dict[str, Any]]]:
                 values[f'param.{name}'] = (text + f' {q.get("unit", "")}').strip()
             else:
                 values[f'param.{name}'] = str(q)
+        comp = f.get('compensation') or {}
+        if comp:
+            values['compensation'] = str(comp.get('kind', ''))
+            values['compensation_how'] = str(comp.get('how', ''))
         message = str(f.get('explanation') or f.get('title') or f.get('mechanism', ''))
         out.append((1, str(f.get('mechanism', '?')), message, values))
     if not out:

@@ -33,6 +33,7 @@ from hyst_id.cli import main
 from hyst_id.diagnosis import diagnose, DiagnoseSettings
 from hyst_id.diagnosis.locate import locate, noise_std
 from hyst_id.diagnosis.mechanisms import Context, MECHANISM_IDS, MECHANISMS
+from hyst_id.diagnosis.mechanisms.base import COMPENSATION_KINDS
 from hyst_id.diagnosis.model import ComposedModel
 from hyst_id.diagnosis.report import plot_diagnosis
 from hyst_id.errors import ConfigError, NoExcitationError, RecordingError
@@ -52,6 +53,7 @@ CASES = {
     'dead_time': ('position', [0.2], None),
     'sensor_lag': ('position', [0.3], None),
     'supply_decay': ('pressure', [1.0 / 600.0], [1.0, 0.0, 0.0]),
+    'gain_drift': ('position', [0.001], None),
     'offset_drift': ('position', [], [1.0, 0.004, 0.0]),
     'saturation': ('position', [0.15, 0.15], None),
     'stiction': ('position', [0.04, 0.01], None),
@@ -113,6 +115,10 @@ def test_each_mechanism_is_named(mech):
     assert d.verdict == mech, d.report()
     f = d.findings[0]
     assert f.explanation and f.params
+    # every finding says whether and how it is compensated, with the mechanism's own kind
+    assert f.compensation['kind'] == MECHANISMS[mech].compensation
+    assert f.compensation['kind'] in COMPENSATION_KINDS and len(f.compensation['how']) > 40
+    assert f'compensation: {f.compensation["how"]}' in d.report()
     if mech == 'stiction':
         check_stick_slip(d, band=0.04 * loop_travel(synthetic(None, seed=5)))
         return
@@ -213,6 +219,7 @@ def test_json_document_has_the_issue_schema(delay_diagnosis, tmp_path):
     assert set(doc['final']) >= {'mechanisms', 'er_train_percent', 'er_holdout_percent'}
     assert doc['final']['mechanisms'] == ['dead_time']
     assert f['params']['delay_s']['unit'] == 's'
+    assert f['compensation']['kind'] == 'not in-line' and 'ahead' in f['compensation']['how']
 
 
 def test_status_for_diagnostics(delay_diagnosis, clean_diagnosis):

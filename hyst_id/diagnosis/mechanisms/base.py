@@ -40,7 +40,13 @@ from typing import Any, Sequence
 
 import numpy as np
 
-__all__ = ['STAGES', 'Context', 'Mechanism', 'Quantity', 'clip_theta']
+__all__ = ['COMPENSATION_KINDS', 'STAGES', 'Context', 'Mechanism', 'Quantity', 'clip_theta']
+
+#: How a block is made up for in operation: by the compensator's tracking or the
+#: identifier's sliding re-identification; by the command limits; by identifying
+#: another H family; not needed (the block is in the reading, not the actuator); or
+#: not at all in-line.
+COMPENSATION_KINDS = ('tracking', 'limits', 'family', 'not needed', 'not in-line')
 
 #: Stages in signal order.
 STAGES = ('command', 'actuator', 'position', 'quantity', 'sensor', 'output')
@@ -237,6 +243,16 @@ class Mechanism:
     def evidence(self, loc: Any) -> tuple[float, dict]:
         """Score in [0, 1] of how well the located mismatch fits this physics, and where."""
         return 0.0, {}
+
+    # -- compensation --------------------------------------------------------
+    #: How the package makes up for the block in operation, one of
+    #: :data:`COMPENSATION_KINDS`.
+    compensation = 'not in-line'
+
+    def compensation_note(self, values: dict[str, Quantity], ctx: Context) -> str:
+        """Whether and how the compensator makes up for the fitted block, in words."""
+        return ('not compensated in-line: the compensator inverts H and B only; the block '
+                'stays in the plant')
 
 
 def clip_theta(theta: Sequence[float], bounds: np.ndarray) -> np.ndarray:

@@ -40,6 +40,7 @@ class DeadTime(Mechanism):
     id = 'dead_time'  # noqa: A003
     title = 'transport delay between the command and the actuator'
     stage = 'command'
+    compensation = 'not in-line'
     placement = 'command -> actuator, before the hysteresis H'
     physics = ('the actuator acts on the command it received some time ago (D/A, field bus, '
                'positioner scan, pneumatic signal line)')
@@ -91,6 +92,13 @@ class DeadTime(Mechanism):
         score += 0.5 * float(np.clip((f['early_late_ratio'] - 1.0) / 2.0, 0.0, 1.0))
         return score, {'correlation_with_rate': {'r': loc.ccf_rate['peak_r'],
                                                  'lag_s': loc.ccf_rate['peak_lag_s']}}
+
+    def compensation_note(self, values, ctx) -> str:
+        """A delay cannot be undone from the present desired value."""
+        d = values['delay_s'].value
+        return (f'not in-line: a {d:.3g} s delay cannot be undone from the present desired '
+                f'value; send the desired value {d:.3g} s ahead (a planned trajectory) or give '
+                'the delay to the controller (a Smith predictor)')
 
 
 MECHANISM = DeadTime()

@@ -42,6 +42,7 @@ class LoopShape(Mechanism):
     id = 'loop_shape'  # noqa: A003
     title = 'curved loop branches (smooth hysteresis)'
     stage = 'actuator'
+    compensation = 'family'
     placement = 'H itself: the hysteresis loop of the actuator'
     physics = ('the hysteresis loop bends (piezo stack, magnetic core, soft seals): its '
                "branches are curves, not the straight lines of the paper's loop")
@@ -88,6 +89,11 @@ class LoopShape(Mechanism):
         score = max(level, early) * (0.5 + 0.5 * periodic)
         return score, {'early_late_ratio': f['early_late_ratio'],
                        'harmonic_fraction': f['harmonic_fraction']}
+
+    def compensation_note(self, values, ctx) -> str:
+        """Identify with the smooth family; the compensator inverts it."""
+        return ('by the H family: identify with --model smooth (or auto) and hand that set to '
+                'the compensator, which inverts either family (family: smooth)')
 
 
 MECHANISM = LoopShape()

@@ -38,6 +38,7 @@ class OffsetDrift(Mechanism):
     id = 'offset_drift'  # noqa: A003
     title = 'slow additive drift of the sensor offset'
     stage = 'output'
+    compensation = 'tracking'
     placement = 'added to the measurement after the calibration'
     physics = ("the sensor's zero moves slowly (warm-up, temperature, reference drift), "
                'independently of the command')
@@ -71,6 +72,12 @@ class OffsetDrift(Mechanism):
         score *= float(np.clip(1.0 - (abs(f['level_trend_t']) - 3.0) / 5.0, 0.0, 1.0))
         return score, {'trend': {'slope_per_s': loc.trend['slope_per_s'],
                                  't': loc.trend['t']}}
+
+    def compensation_note(self, values, ctx) -> str:
+        """Followed online, not extrapolated."""
+        return ('tracked, not extrapolated: the tracking of the compensator (tracking.enabled) '
+                'follows the offset from the measurement (the sliding re-identification '
+                'refits it too); a sensor re-zeroed before the run removes the cause')
 
 
 MECHANISM = OffsetDrift()

@@ -69,6 +69,7 @@ class RateDependence(Mechanism):
     title = 'hysteresis loop widening with the command rate'
     stage = 'actuator'
     families = ('tk',)   # it rewrites the paper's loop itself
+    compensation = 'not in-line'
     placement = 'inside the hysteresis H (its left and right lines)'
     physics = ('rate-dependent losses in the actuator (viscous drag, eddy currents) widen '
                'the loop when the command moves fast')
@@ -128,6 +129,12 @@ class RateDependence(Mechanism):
         score = 0.6 * float(np.clip((abs(f['direction_split_t']) - 3.0) / 5.0, 0.0, 1.0))
         score += 0.4 * float(np.clip((1.0 / max(f['slow_fast_ratio'], 1e-9) - 1.0), 0.0, 1.0))
         return score, {'rising_vs_falling_t': f['direction_split_t']}
+
+    def compensation_note(self, values, ctx) -> str:
+        """H and its inverse are rate independent."""
+        return ('not compensated: H and its inverse are rate independent, so the '
+                'compensation is right only near the rates it was identified at; identify at '
+                'the operating rates')
 
 
 MECHANISM = RateDependence()

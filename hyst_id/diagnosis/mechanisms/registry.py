@@ -23,6 +23,7 @@ from __future__ import annotations
 
 from hyst_id.diagnosis.mechanisms import (
     dead_time,
+    gain_drift,
     loop_shape,
     offset_drift,
     rate_dependence,
@@ -40,7 +41,7 @@ __all__ = ['MECHANISMS', 'MECHANISM_IDS', 'Context', 'Mechanism', 'Quantity', 'g
 #: Every mechanism by id, in the issue's order.
 MECHANISMS: dict[str, Mechanism] = {m.MECHANISM.id: m.MECHANISM for m in (
     dead_time, sensor_lag, supply_decay, offset_drift, saturation, stiction,
-    static_nonlinearity, rate_dependence, loop_shape)}
+    static_nonlinearity, rate_dependence, loop_shape, gain_drift)}
 
 #: The ids alone.
 MECHANISM_IDS = tuple(MECHANISMS)

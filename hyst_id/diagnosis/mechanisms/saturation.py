@@ -40,6 +40,7 @@ class Saturation(Mechanism):
     id = 'saturation'  # noqa: A003
     title = 'travel end stop'
     stage = 'position'
+    compensation = 'limits'
     placement = 'on the actuator position, after the backlash B, before the sensor'
     physics = 'the actuator hits a mechanical stop or travel limit and cannot follow the command'
     names = ('cut_low_fraction', 'cut_high_fraction')
@@ -110,6 +111,15 @@ class Saturation(Mechanism):
         lv = loc.regimes.get('level', [])
         return score, {'command_levels': [b['label'] for b in (lv[:1] + lv[-1:])
                                           if b['flagged']]}
+
+    def compensation_note(self, values, ctx) -> str:
+        """The stops bound what any command can reach: set the command limits there."""
+        cmds = [f'{side} {values[f"command_at_{side}_stop"].value:.4g} {ctx.cmd_unit}'
+                for side in ('low', 'high') if f'command_at_{side}_stop' in values]
+        where = (': set min_command/max_command of the compensator at the commands where the '
+                 'actuator meets its stops (' + ', '.join(cmds) + ')') if cmds else ''
+        return ('by the command limits: a desired value beyond the stops cannot be reached, '
+                'and commands beyond them only wind the loop up' + where)
 
 
 MECHANISM = Saturation()

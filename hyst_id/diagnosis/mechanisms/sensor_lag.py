@@ -41,6 +41,7 @@ class SensorLag(Mechanism):
     id = 'sensor_lag'  # noqa: A003
     title = 'unmodelled first-order lag in the measurement'
     stage = 'sensor'
+    compensation = 'not needed'
     placement = 'after the modelled sensor dynamics, before the calibration'
     physics = ('the measurement follows the true quantity through a first-order lag: '
                'transmitter filtering, tubing to the transducer, thermal mass of the sensor')
@@ -97,6 +98,13 @@ class SensorLag(Mechanism):
         score += 0.5 * float(np.clip(1.0 - abs(f['early_late_ratio'] - 1.5), 0.0, 1.0))
         return score, {'correlation_with_rate': {'r': loc.ccf_rate['peak_r'],
                                                  'lag_s': loc.ccf_rate['peak_lag_s']}}
+
+    def compensation_note(self, values, ctx) -> str:
+        """The lag is in the reading, not in the actuator."""
+        tau = values['tau_lag_s'].value
+        return (f'not needed for the actuator: the {tau:.3g} s lag is in the reading, so H⁻¹ '
+                'places the actuator right and the reading follows later; a controller closed '
+                'on this reading must allow for the lag')
 
 
 MECHANISM = SensorLag()

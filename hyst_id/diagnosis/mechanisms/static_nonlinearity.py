@@ -42,6 +42,7 @@ class StaticNonlinearity(Mechanism):
     id = 'static_nonlinearity'  # noqa: A003
     title = 'nonlinear map from position to the sensed quantity'
     stage = 'quantity'
+    compensation = 'not in-line'
     placement = 'between the actuator position and the sensor dynamics'
     physics = ('the sensed quantity is not proportional to the actuator position (valve '
                'characteristic, pneumatic pressure/flow map, nonlinear transducer)')
@@ -102,6 +103,12 @@ class StaticNonlinearity(Mechanism):
         lv = loc.regimes.get('level', [])
         return score, {'command_levels': [{'level': b['label'], 'mean': b['mean']}
                                           for b in lv if b['flagged']]}
+
+    def compensation_note(self, values, ctx) -> str:
+        """No inverse of the static curve in the compensator yet."""
+        return ('not compensated in-line yet: the compensator has no inverse of a static '
+                'curve between position and the measured quantity; the smooth H family '
+                '(--model auto) absorbs part of a curved characteristic')
 
 
 MECHANISM = StaticNonlinearity()

@@ -76,6 +76,7 @@ class Stiction(Mechanism):
     title = 'stick-slip friction in the actuator'
     stage = 'position'
     families = ('tk',)   # it rewrites the paper's loop itself
+    compensation = 'not in-line'
     placement = 'on the actuator position, after the backlash B, before the end stops'
     physics = ('static friction holds the actuator until the drive force exceeds it, then the '
                'actuator slips: a ramp becomes a staircase')
@@ -179,6 +180,13 @@ class Stiction(Mechanism):
         score += 0.4 * float(np.clip((f['slow_fast_ratio'] - 1.0) / 1.0, 0.0, 1.0))
         return score, {'stuck_fraction': f.get('stuck_fraction', 0.0),
                        'slow_motion_rms_ratio': f['slow_fast_ratio']}
+
+    def compensation_note(self, values, ctx) -> str:
+        """No in-line inverse of stick-slip."""
+        band = values['slip_band']
+        return (f'not in-line: H⁻¹ cannot undo stick-slip (slips of {band.value:.3g} '
+                f'{band.unit}); a dither on the command or a positioner with friction '
+                'compensation can')
 
 
 MECHANISM = Stiction()

@@ -32,42 +32,27 @@ from __future__ import annotations
 
 import numpy as np
 
-from hyst_id.diagnosis.mechanisms.base import Context, Mechanism, Quantity
+from hyst_id.diagnosis.mechanisms.base import Quantity
+from hyst_id.diagnosis.mechanisms.time_gain import TimeGain
 
 __all__ = ['SupplyDecay', 'MECHANISM']
 
 
-class SupplyDecay(Mechanism):
+class SupplyDecay(TimeGain):
     """Exponentially decaying gain on the sensed quantity."""
 
     id = 'supply_decay'  # noqa: A003
     title = 'plant gain decaying over time (supply running down)'
-    stage = 'output'
-    placement = 'on the sensed quantity (a gain in time), before the sensor offset'
     physics = ('the supply pressure falls during the run (vessels emptying without '
                'regulation), so pressure and flow for a given opening fall with it')
     names = ('decay_rate_per_s',)
     units = ('1/s',)
-    n_linear = 1
+    rate_range = (0.01, 5.0)          # a hundredth to five e-foldings
+    start_changes = (0.1, 0.3, 1.0)   # a tenth, a third and one e-folding
 
-    def bounds(self, ctx: Context) -> np.ndarray:
-        """Decay rates from a hundredth to five e-foldings per training duration."""
-        d = max(ctx.train_duration_s, 1e-9)
-        return np.array([[0.01 / d, 5.0 / d]])
-
-    def starts(self, ctx: Context) -> list[np.ndarray]:
-        """A tenth, a third and one e-folding over the training part."""
-        d = max(ctx.train_duration_s, 1e-9)
-        return [np.array([x / d]) for x in (0.1, 0.3, 1.0)]
-
-    def null(self, ctx: Context) -> np.ndarray:
-        """Slowest decay (the block is then nearly the identity)."""
-        return self.bounds(ctx)[:, 0].copy()
-
-    def output(self, theta, t_s, columns, ctx) -> list[np.ndarray]:
-        """Decaying gain on every signal column, plus the decaying offset ``g(t)``."""
-        g = np.exp(-float(theta[0]) * (t_s - ctx.t_s[0]))
-        return [c * g for c in columns[:-1]] + [g, columns[-1]]
+    def gain(self, rate: float, elapsed_s: np.ndarray) -> np.ndarray:
+        """Exponential decay ``exp(-rate t)``."""
+        return np.exp(-rate * elapsed_s)
 
     def describe(self, theta, coef, info, ctx) -> dict[str, Quantity]:
         """Time constant and the gain lost over the record."""
@@ -90,12 +75,13 @@ class SupplyDecay(Mechanism):
                 'measured supply pressure; an identification from an early run will '
                 'over-predict later ones.')
 
-    def evidence(self, loc) -> tuple[float, dict]:
-        """A time trend whose size scales with the output level."""
-        f = loc.features
-        score = float(np.clip((abs(f['level_trend_t']) - 3.0) / 5.0, 0.0, 1.0))
-        return score, {'trend': {'slope_per_s': loc.trend['slope_per_s'],
-                                 'level_t': loc.trend['level_t']}}
+    def compensation_note(self, values, ctx) -> str:
+        """Followed online, not extrapolated."""
+        return ('tracked, not extrapolated: the tracking of the compensator '
+                '(tracking.enabled) follows the falling gain from the measurement, and the '
+                'sliding re-identification of the identifier (sliding.enabled) swaps in a '
+                'refitted set once the change is clear on the newest samples; a regulated '
+                'supply removes the cause')
 
 
 MECHANISM = SupplyDecay()

@@ -1,0 +1,82 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""A gain on the sensed quantity changing over the run (``supply_decay``, ``gain_drift``).
+
+Placement: ``y = g(t) (k s + b0) + b1`` with ``g(t0) = 1``; ``b0`` is a linear
+parameter (the offset scaled with the gain), so the block adds one searched
+parameter, a rate. A subclass says how the gain changes (:meth:`TimeGain.gain`)
+and over which range of changes over the training part its rate is searched
+(:attr:`TimeGain.rate_range`, :attr:`TimeGain.start_changes`). Both are
+followed online rather than extrapolated (the compensator's tracking, the
+identifier's sliding re-identification).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from hyst_id.diagnosis.mechanisms.base import Context, Mechanism
+
+__all__ = ['TimeGain']
+
+
+class TimeGain(Mechanism):
+    """Base class: a time-varying gain on the sensed quantity (one rate, one linear term)."""
+
+    stage = 'output'
+    placement = 'on the sensed quantity (a gain in time), before the sensor offset'
+    n_linear = 1
+    compensation = 'tracking'
+    #: Rate bounds as changes over the training duration (per that duration).
+    rate_range: tuple[float, float] = (0.01, 5.0)
+    #: Starting rates, same unit.
+    start_changes: tuple[float, ...] = (0.1, 0.3, 1.0)
+
+    def gain(self, rate: float, elapsed_s: np.ndarray) -> np.ndarray:
+        """``g`` at ``elapsed_s`` seconds from the record's start (``g(0) = 1``)."""
+        raise NotImplementedError
+
+    def bounds(self, ctx: Context) -> np.ndarray:
+        """:attr:`rate_range` per training duration."""
+        d = max(ctx.train_duration_s, 1e-9)
+        return np.array([[self.rate_range[0] / d, self.rate_range[1] / d]])
+
+    def starts(self, ctx: Context) -> list[np.ndarray]:
+        """:attr:`start_changes` per training duration."""
+        d = max(ctx.train_duration_s, 1e-9)
+        return [np.array([x / d]) for x in self.start_changes]
+
+    def null(self, ctx: Context) -> np.ndarray:
+        """Slowest change (the block is then nearly the identity)."""
+        return self.bounds(ctx)[:, 0].copy()
+
+    def output(self, theta, t_s, columns, ctx) -> list[np.ndarray]:
+        """The gain on every signal column, plus the gained offset ``g(t)``."""
+        g = self.gain(float(theta[0]), t_s - ctx.t_s[0])
+        return [c * g for c in columns[:-1]] + [g, columns[-1]]
+
+    def evidence(self, loc) -> tuple[float, dict]:
+        """A time trend whose size scales with the output level."""
+        f = loc.features
+        score = float(np.clip((abs(f['level_trend_t']) - 3.0) / 5.0, 0.0, 1.0))
+        return score, {'trend': {'slope_per_s': loc.trend['slope_per_s'],
+                                 'level_t': loc.trend['level_t']}}
+
+    def compensation_note(self, values, ctx) -> str:
+        """Followed online, not extrapolated."""
+        return ('tracked, not extrapolated: the tracking of the compensator '
+                '(tracking.enabled) follows the gain from the measurement, and the sliding '
+                're-identification of the identifier (sliding.enabled) swaps in a refitted '
+                'set once the change is clear on the newest samples')
