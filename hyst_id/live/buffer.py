@@ -21,6 +21,7 @@ does (:func:`hyst_id.io.streams.pair_streams`).
 
 from __future__ import annotations
 
+import bisect
 import time
 
 import numpy as np
@@ -38,6 +39,9 @@ class SampleBuffer:
     built). At most ``max_samples`` of each stream are kept (the oldest are
     dropped, in blocks of a tenth).
     """
+
+    #: Samples before a window's bisected start that are also looked at (late arrivals).
+    ORDER_MARGIN = 1000
 
     def __init__(self, max_samples: int = 2000000) -> None:
         self.max_samples = int(max_samples)
@@ -92,13 +96,22 @@ class SampleBuffer:
 
         With ``last_s`` only the measurements of the newest ``last_s`` seconds
         (and the commands from then on, with the one in effect at its start)
-        are paired: a sliding window costs its own length, not the whole
-        buffer's.
+        are paired: a sliding window costs about its own length, not the
+        whole buffer's (the streams arrive nearly in order, so the window's
+        start is found by bisection and :data:`ORDER_MARGIN` samples before
+        it are looked at too).
         """
-        ct, cv = np.array(self.cmd_t, dtype=np.int64), np.array(self.cmd_v)
-        mt, mv = np.array(self.meas_t, dtype=np.int64), np.array(self.meas_v)
+        if last_s is not None and self.meas_t:
+            newest = max(self.meas_t[-self.ORDER_MARGIN:])
+            since = int(newest - last_s * 1e9)
+            m0 = max(bisect.bisect_left(self.meas_t, since) - self.ORDER_MARGIN, 0)
+            c0 = max(bisect.bisect_left(self.cmd_t, since) - self.ORDER_MARGIN, 0)
+            ct, cv = np.array(self.cmd_t[c0:], dtype=np.int64), np.array(self.cmd_v[c0:])
+            mt, mv = np.array(self.meas_t[m0:], dtype=np.int64), np.array(self.meas_v[m0:])
+        else:
+            ct, cv = np.array(self.cmd_t, dtype=np.int64), np.array(self.cmd_v)
+            mt, mv = np.array(self.meas_t, dtype=np.int64), np.array(self.meas_v)
         if last_s is not None and mt.size:
-            since = int(mt.max() - last_s * 1e9)
             keep = mt >= since
             mt, mv = mt[keep], mv[keep]
             lead = ct >= since

@@ -50,9 +50,10 @@ import numpy as np
 from scipy import stats
 
 from hyst_id.errors import ConfigError, HystIdError
-from hyst_id.identification import Identification, identify, IdentifySettings
+from hyst_id.identification import Identification, identify, IdentifySettings, SeedRun
 from hyst_id.identification.quality import assess
 from hyst_id.identification.refine import refine
+from hyst_id.io.jsonable import jsonable
 from hyst_id.io.recording import Recording
 from hyst_id.live.gate import QualityGate
 from hyst_id.signals.noise import noise_floor_percent
@@ -130,13 +131,13 @@ class SwapDecision:
     gate_reasons: list = field(default_factory=list)
 
     def to_dict(self) -> dict:
-        """JSON-ready form (without the candidate's parameters)."""
-        return {'swap': self.swap, 'reason': self.reason,
-                'holdout_er_current_percent': self.er_current_percent,
-                'holdout_er_candidate_percent': self.er_candidate_percent,
-                'p_value': self.p_value, 'candidate_source': self.source,
-                'window_s': self.window_s, 'n_samples': self.n_samples,
-                'gate_reasons': list(self.gate_reasons)}
+        """JSON-ready form (without the candidate's parameters); NaN as null."""
+        return jsonable({'swap': self.swap, 'reason': self.reason,
+                         'holdout_er_current_percent': self.er_current_percent,
+                         'holdout_er_candidate_percent': self.er_candidate_percent,
+                         'p_value': self.p_value, 'candidate_source': self.source,
+                         'window_s': self.window_s, 'n_samples': self.n_samples,
+                         'gate_reasons': list(self.gate_reasons)})
 
 
 def tail_window(rec: Recording, window_s: float) -> Recording:
@@ -211,9 +212,17 @@ def _polish(current: Identification, train: Recording, max_nfev: int) -> Identif
                        max_nfev=max_nfev)
     pred = spec.simulate(x, train.t_s, train.command)
     params = dict(zip(current.names, (float(a) for a in x)))
-    return replace(current, params=params, params_mean=dict(params),
-                   er_percent=_er(train.measurement, pred),
-                   er_mean_params_percent=_er(train.measurement, pred),
+    er = _er(train.measurement, pred)
+    # one run of its own: the current set's seeds were fitted on other data, and their
+    # spread must not speak for (or against) this set in the quality gate
+    run = SeedRun(seed=-1, x_raw=np.asarray(x, dtype=float), x=np.asarray(x, dtype=float),
+                  sign=current.output_sign, fun=float(fun), er_percent=er,
+                  er_gaass_percent=er, nfev=0, nit=0, best_history=np.zeros(0),
+                  message='current set polished on the window', initial=current.initial,
+                  hold=current.hold)
+    return replace(current, params=params, params_mean=dict(params), er_percent=er,
+                   er_mean_params_percent=er, runs=[run], bounds=spec.bounds.copy(),
+                   domain_source=spec.domain_source,
                    noise_floor_percent=noise_floor_percent(train.measurement),
                    warnings=[], poorly_determined={}, source=train.source)
 
@@ -269,17 +278,19 @@ def reidentify_window(current: Identification, window: Recording, *,
     train = window.window(0, n_train)
     candidates = [('warm start (current set polished)', _polish(current, train, polish_nfev))]
     stop_point()
+    failed = ''
     if fresh_settings is not None:
         try:
-            fresh = identify(train, settings=fresh_settings, should_stop=should_stop)
+            fresh = identify(train, settings=fresh_settings, should_stop=should_stop,
+                             on_generation=lambda *_: stop_point())
             candidates.append(('fresh identification', fresh))
         except HystIdError as exc:
             if should_stop is not None and should_stop():
                 raise
-            candidates.append(('fresh identification failed: ' + str(exc), None))
+            failed = f' (the fresh identification failed: {exc})'
     stop_point()
-    fitted = [(s, c) for s, c in candidates if c is not None]
-    source, cand = min(fitted, key=lambda sc: sc[1].er_percent)
+    source, cand = min(candidates, key=lambda sc: sc[1].er_percent)
+    source += failed
     warnings, cand.poorly_determined = assess(cand, train)
     cand.warnings = list(warnings)
     y = window.measurement

@@ -33,7 +33,6 @@ from __future__ import annotations
 from concurrent.futures import ThreadPoolExecutor
 import json
 import math
-import os
 from pathlib import Path
 import time
 from typing import Any, Callable
@@ -78,7 +77,7 @@ from hyst_id.nodes.support import (
     spin_node,
     stamp_ns,
 )
-from hyst_id.nodes.support.identifier_params import PARAMS
+from hyst_id.nodes.support.identifier_params import default_params_out, PARAMS
 from hyst_id.nodes.support.sliding import SlidingLink
 
 try:  # optional: std_srvs is not a dependency of the package
@@ -95,12 +94,6 @@ SENSOR_QUEUE_DEPTH = 1000
 _TRIGGERS = ('identify_now', 'cancel_now', 'diagnose_now')
 
 
-def default_params_out() -> Path:
-    """``$ROS_HOME/hyst_id/compensator.yaml`` (``ROS_HOME`` defaults to ``~/.ros``)."""
-    home = os.environ.get('ROS_HOME') or os.path.join(os.path.expanduser('~'), '.ros')
-    return Path(home) / 'hyst_id' / 'compensator.yaml'
-
-
 class Identifier(HystNode):
     """Collect samples, identify the chain with GAASS, publish and push the result."""
 
@@ -112,6 +105,8 @@ class Identifier(HystNode):
         self.job: IdentificationJob | None = None
         self.diag_job: DiagnosisJob | None = None
         self.last_identification: Identification | None = None
+        #: The last set handed over (params file, compensator): what sliding refits.
+        self.handed_over: Identification | None = None
         self.last_document: dict | None = None
         self.last_diagnosis: dict | None = None
         self.last_error = ''
@@ -244,6 +239,7 @@ class Identifier(HystNode):
             return False, f'only {n} samples collected (min_samples {self.p("min_samples")})'
         if self._busy():
             return False, self._busy()
+        self.sliding.cancel('a full identification starts')
         try:
             rec = validate_recording(self.collected_recording())
             model = self.p('model')
@@ -366,11 +362,12 @@ class Identifier(HystNode):
         return QualityGate(self.p('gate_max_floor_ratio'), self.p('gate_max_uncertainty'))
 
     def publish_identified(self, ident: Identification, rec: Recording, elapsed_s: float,
-                           choice: Any = None, sliding: dict | None = None) -> None:
+                           choice: Any = None, sliding: dict | None = None) -> bool:
         """Publish an identified set and hand it over (params file, compensator) if it may be.
 
         ``sliding`` (a swap decision, JSON-ready) marks a set from a
-        sliding-window re-identification; it goes into the document.
+        sliding-window re-identification; it goes into the document. Returns
+        whether the set was handed over.
         """
         self.last_identification = ident
         self._last_rec = rec
@@ -381,11 +378,12 @@ class Identifier(HystNode):
         comp = doc['compensator_params']
         if comp is None and not doc['gate']['passed']:
             self._publish_held_back(ident, rec, doc)
-            return
+            return False
         if comp is None:
             self._fail(f'identified {ident.channel} (%e_r {ident.er_percent:.3f}) but '
                        f'{doc["compensator_note"]}; {self._kept()}')
-            return
+            return False
+        self.handed_over = ident
         if choice is not None:
             doc['model_choice'] = choice.to_dict()
             self.get_logger().info('H family chosen on held-out data: ' + ', '.join(
@@ -419,6 +417,7 @@ class Identifier(HystNode):
                               self.p('push_timeout_s'))
         if self.on_identified is not None:
             self.on_identified(doc)
+        return True
 
     def _publish_held_back(self, ident: Identification, rec: Recording, doc: dict) -> None:
         """Publish a result the quality gate holds back: nothing is handed over."""
@@ -500,8 +499,8 @@ class Identifier(HystNode):
         """Stop workers, then the node."""
         if hasattr(self, '_warm'):    # also called on a node whose __init__ failed
             self._warm.shutdown(wait=False, cancel_futures=True)
-            jobs = [j for j in (self.job, self.diag_job, self.sliding.cancel(), *self._cancelled)
-                    if j is not None]
+            jobs = [j for j in (self.job, self.diag_job, self.sliding.cancel('shutdown'),
+                                *self._cancelled) if j is not None]
             for job in jobs:
                 job.cancel()
             for job in jobs:        # worker processes end within 0.2 s of a cancel

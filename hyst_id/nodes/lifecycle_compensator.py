@@ -28,7 +28,8 @@ driven by the standard lifecycle state machine (``~/change_state``,
   ``require_model`` and no valid set the transition fails, with the reason
   in the log;
 * **activate**: the model state restarts at the command the actuator holds
-  (the last command sent, else ``initial_command``) and commands flow;
+  (the last command sent; ``initial_command`` before any, or after a
+  cleanup) and commands flow;
 * **deactivate**: commands stop; the actuator holds its last command;
 * **cleanup**: the model state is reset to ``initial_command`` (the loop's
   memory is forgotten: after a cleanup the actuator may have been moved by

@@ -23,6 +23,7 @@ a second swap because the newer set is no better.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 
 from conftest import make_node, spin_nodes_until
@@ -59,7 +60,8 @@ def _feed(node: Identifier, k0: int, n: int, gain: float, offset: float) -> None
         node.buffer.add_measurement(T0_NS + k * DT_NS + 1000, float(y[k]))
 
 
-def test_identifier_swaps_in_a_better_set_and_refuses_one_that_is_not(ctx, tmp_path):
+def _started(ctx, tmp_path):
+    """An identifier with sliding on, a listener, and the first set identified and handed over."""
     out = tmp_path / 'comp.yaml'
     node = make_node(ctx, Identifier, parameter_overrides=[
         Parameter(k, value=v) for k, v in {
@@ -81,7 +83,12 @@ def test_identifier_swaps_in_a_better_set_and_refuses_one_that_is_not(ctx, tmp_p
     assert spin_nodes_until(ctx[0], spin, lambda: bool(params), 180.0)
     first = params[-1]
     assert 'sliding' not in first and first['compensator_params'] is not None
-    assert not decisions                                  # no window yet: the buffer was cleared
+    return node, spin, params, decisions
+
+
+def test_identifier_swaps_in_a_better_set_and_refuses_one_that_is_not(ctx, tmp_path):
+    node, spin, params, decisions = _started(ctx, tmp_path)
+    out = tmp_path / 'comp.yaml'
     _feed(node, 1200, 1400, 0.8, 0.3)                     # 70 s of the drifted plant
     assert spin_nodes_until(ctx[0], spin, lambda: len(decisions) >= 2, 180.0), decisions
     swap, refusal = decisions[0], decisions[1]
@@ -92,8 +99,20 @@ def test_identifier_swaps_in_a_better_set_and_refuses_one_that_is_not(ctx, tmp_p
         params[-1]['compensator_params']['m_l'])
     assert not refusal['swap'] and refusal['reason'].startswith(
         ('not better', 'not significantly better')), refusal
-    assert len(params) == 2                               # the refusal handed nothing over
     assert node.sliding.swaps == 1 and node.sliding.decisions >= 2
+    assert node.handed_over is not None and node.handed_over.params == pytest.approx(
+        {k: float(v) for k, v in params[-1]['params'].items()})
+
+
+def test_a_decision_on_a_set_no_longer_in_use_is_discarded(ctx, tmp_path):
+    """A set handed over while a window is fitted (a full identification) wins."""
+    node, spin, params, decisions = _started(ctx, tmp_path)
+    _feed(node, 1200, 1400, 0.8, 0.3)                     # a swap would follow
+    assert spin_nodes_until(ctx[0], spin, lambda: node.sliding.job is not None, 60.0)
+    node.handed_over = dataclasses.replace(node.handed_over)   # another set handed over
+    assert spin_nodes_until(ctx[0], spin, lambda: bool(decisions), 180.0)
+    assert not decisions[0]['swap'] and decisions[0]['reason'].startswith('superseded')
+    assert len(params) == 1                               # nothing was handed over
 
 
 def test_sliding_holdout_must_be_shorter_than_the_window(ctx):

@@ -16,12 +16,22 @@
 
 from __future__ import annotations
 
+import os
+from pathlib import Path
+
 from hyst_id.io.recording import CHANNELS
 from hyst_id.nodes.support.params import field_params, Param, topic_params
 from hyst_id.nodes.support.qos import IDENTIFIED_PARAMS_TOPIC
 from hyst_id.nodes.support.sliding import SLIDING_PARAMS
 
-__all__ = ['PARAMS']
+__all__ = ['PARAMS', 'default_params_out']
+
+
+def default_params_out() -> Path:
+    """``$ROS_HOME/hyst_id/compensator.yaml`` (``ROS_HOME`` defaults to ``~/.ros``)."""
+    home = os.environ.get('ROS_HOME') or os.path.join(os.path.expanduser('~'), '.ros')
+    return Path(home) / 'hyst_id' / 'compensator.yaml'
+
 
 PARAMS = [
     Param('channel', 'position', 'measured channel to identify', choices=CHANNELS,

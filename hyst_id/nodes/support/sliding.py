@@ -23,11 +23,17 @@ set over (params file, compensator, latched topic) only when
 better there and passes the quality gate. CPU is bounded: after a fit that
 took ``E`` s the next waits at least ``E (1 / sliding.cpu_share - 1)`` s.
 Every decision, swap or not, is logged with its reason and published
-latched on ``~/sliding`` (JSON).
+latched on ``~/sliding`` (JSON). The set refitted is the one last handed
+over; a decision reached while another set was handed over (a full
+identification) is discarded as superseded, and a full identification
+cancels a running window fit. The fits hold the GIL most of the time: a
+compensator in the same process (``bringup``) sees its latency rise while
+one runs; run the identifier in its own process for a 1 kHz loop.
 """
 
 from __future__ import annotations
 
+from dataclasses import replace
 import json
 import time
 from typing import Any
@@ -93,7 +99,7 @@ class SlidingLink:
     def _due(self, now: float) -> bool:
         p = self.node.p
         return (p('sliding.enabled') and self.job is None and self.node.job is None
-                and self.node.last_identification is not None
+                and self.node.handed_over is not None
                 and now - self._last_start >= p('sliding.period_s')
                 and now >= self._next_allowed)
 
@@ -119,14 +125,16 @@ class SlidingLink:
             return
         fresh = None
         if p('sliding.fresh_seeds') > 0:
-            fresh = make_settings(seeds=p('sliding.fresh_seeds'), seed_offset=p('seed_offset'),
-                                  pop_size=p('pop_size'),
-                                  generations=p('sliding.fresh_generations'), c=p('c'),
-                                  xi=p('xi'), workers=1, refine=True, restarts=0,
-                                  er_bound_percent=None)
+            # no global phase: a drifting window often ends above 1.1 x the floor, and
+            # the phase's 200,000 evaluations would dwarf fresh_generations
+            fresh = replace(make_settings(
+                seeds=p('sliding.fresh_seeds'), seed_offset=p('seed_offset'),
+                pop_size=p('pop_size'), generations=p('sliding.fresh_generations'), c=p('c'),
+                xi=p('xi'), workers=1, refine=True, restarts=0, er_bound_percent=None),
+                global_evals=0)
         rule = SwapRule(holdout_s=p('sliding.holdout_s'), min_gain=p('sliding.min_gain'),
                         max_p=p('sliding.max_p'))
-        self.job = SlidingJob(node.last_identification, window, rule=rule,
+        self.job = SlidingJob(node.handed_over, window, rule=rule,
                               gate=node.quality_gate(), fresh_settings=fresh)
 
     def _finished(self, job: SlidingJob) -> None:
@@ -140,13 +148,27 @@ class SlidingLink:
             return
         d = job.result
         doc = {**d.to_dict(), 'elapsed_s': job.elapsed_s}
-        self._publish(doc)
-        if not d.swap:
-            log.info(f'sliding re-identification kept the current set: {d.reason}')
+        if d.swap and job.current is not self.node.handed_over:
+            doc['swap'] = False
+            doc['reason'] = ('superseded: another set was handed over while this window was '
+                             f'fitted (its decision was: {d.reason})')
+        elif d.swap and not self.node.p('sliding.enabled'):
+            doc['swap'] = False
+            doc['reason'] = f'sliding was disabled while this window was fitted ({d.reason})'
+        if not doc['swap']:
+            log.info(f'sliding re-identification kept the current set: {doc["reason"]}')
+            self._publish(doc)
+            return
+        if not self.node.publish_identified(d.candidate, job.window, job.elapsed_s,
+                                            sliding=doc):
+            doc['swap'] = False
+            doc['reason'] = f'not handed over (see the identifier log): {d.reason}'
+            log.warning(f'sliding re-identification: {doc["reason"]}')
+            self._publish(doc)
             return
         self.swaps += 1
-        log.warning(f'sliding re-identification swaps the set: {d.reason}')
-        self.node.publish_identified(d.candidate, job.window, job.elapsed_s, sliding=doc)
+        log.warning(f'sliding re-identification swapped the set: {d.reason}')
+        self._publish(doc)
 
     def _publish(self, doc: dict) -> None:
         self.last = doc
@@ -163,9 +185,10 @@ class SlidingLink:
             out['sliding_last'] = self.last.get('reason', '')
         return out
 
-    def cancel(self) -> SlidingJob | None:
-        """Cancel a running job (node shutdown); return it so the caller can wait."""
+    def cancel(self, why: str) -> SlidingJob | None:
+        """Cancel a running job; return it so the caller can wait for its thread."""
         job, self.job = self.job, None
         if job is not None:
             job.cancel()
+            self.node.get_logger().info(f'sliding re-identification cancelled: {why}')
         return job
