@@ -27,8 +27,9 @@ with a desired value of minor loops:
 (a) **fixed**: the starting set's inverse throughout (the paper);
 (b) **sliding**: every 30 s the newest 60 s of closed-loop data are refitted
     (:func:`hyst_id.live.sliding.reidentify_window`, 10 s held out, the
-    identifier node's swap rule and gate) and a better set swapped in at once
-    (the node swaps when its worker is done, seconds later);
+    identifier node's swap rule, gate and default fresh fit: one seed of 100
+    generations, no global phase) and a better set swapped in at once (the
+    node swaps when its worker is done, seconds later);
 (c) **tracking**: the compensator's gain/offset tracker (forgetting 20 s).
 
 Prints the rms of reading − desired per minute for each, the swaps with
@@ -130,7 +131,7 @@ def run(kind: str, args: argparse.Namespace, first) -> tuple[np.ndarray, np.ndar
                               60.0)
             t0 = time.perf_counter()
             d = reidentify_window(current, rec, fresh_settings=IdentifySettings(
-                seeds=(0,), maxiter=60, workers=1, restarts=0))
+                seeds=(0,), maxiter=100, workers=1, restarts=0, global_evals=0))
             events.append((float(tk), d.swap, d.reason, time.perf_counter() - t0))
             if d.swap:
                 current = d.candidate

@@ -65,6 +65,10 @@ def add_settings_arguments(parser: argparse.ArgumentParser) -> None:
     g.add_argument('--restarts', type=int, default=4,
                    help='extra GAASS runs per seed while %%e_r stays above 1.05 x the '
                    'noise floor (default 4; 0 = one run per seed)')
+    g.add_argument('--global-evals', type=int, default=200000, metavar='N',
+                   help='evaluations of the global phase run when the best fit stays above '
+                   '1.1 x the noise floor (default 200000; 0 = no global phase: faster, '
+                   'but a trapped fit stays trapped)')
     g.add_argument('--domains', default='auto', metavar='auto|paper|YAML',
                    help="search domains: derived from the data (auto), the paper's "
                    'preset (paper), or a YAML mapping name: [low, high] that overrides '
@@ -92,7 +96,8 @@ def make_settings(args: argparse.Namespace) -> IdentifySettings:
     return config.make_settings(
         seeds=args.seeds, seed_offset=args.seed_offset, pop_size=args.pop_size,
         generations=args.generations, c=args.c, xi=args.xi, workers=args.workers,
-        refine=not args.gaass_only, restarts=args.restarts, er_bound_percent=args.er_bound)
+        refine=not args.gaass_only, restarts=args.restarts, er_bound_percent=args.er_bound,
+        global_evals=args.global_evals)
 
 
 def make_spec(args: argparse.Namespace, rec: Recording, family: str | None = None) -> ChainSpec:

@@ -164,6 +164,8 @@ CASES = [
                                         str(d / 'nodomains.yaml')], 'cannot read'),
     ('domains-not-yaml', lambda d: [str(write_csv(d / 'ok4.csv')), '--domains',
                                     str(_text(d / 'bad.yaml', 'm_l: [1, \n'))], 'YAML'),
+    ('negative-global-evals', lambda d: [str(write_csv(d / 'ok6.csv')), '--global-evals',
+                                         '-1'], 'global evaluations'),
     ('bad-columns-option', lambda d: [str(write_csv(d / 'ok5.csv')), '--columns', 't,command'],
      'three'),
 ]

@@ -183,7 +183,7 @@ def check_stick_slip(d, band: float) -> None:
 
 @pytest.mark.slow
 def test_stick_slip_is_lined_up_on_held_out_data_often(record_property):
-    """Twelve noise seeds: every one named and improved, a good share at the floor.
+    """Six noise seeds: every one named and improved, a share at the floor.
 
     Whether a record ends at the floor on held-out data depends on single
     samples (a slip landing one sample off costs a whole jump), so the last
@@ -191,19 +191,21 @@ def test_stick_slip_is_lined_up_on_held_out_data_often(record_property):
     seeds 5..16 x {unperturbed, round-off probe} (``bench/claim_spreads.py
     --only stiction --seeds 12``): named 24/24, held-out gain 23.6 % to
     80.5 %, final/floor 0.93 to 3.66 with 14 of 24 under 1.5 (5 to 9 of 12
-    per run, CI on another CPU make: 5). Bounds outside that spread: a
-    quarter (3 of 12) at the floor, every one improved by at least 15 % and
-    within 4.5 x the floor.
+    per run, CI on another CPU make: 5). Seeds 5..10 alone (this test, six
+    to keep CI short; the twelve stay in the benchmark): final/floor 3.15,
+    0.96, 1.48, 0.94, 0.97, 1.80, gain 23.4 % to 79.8 %, 3 to 4 under 1.5
+    (seed 7 sits on the line). Bounds outside that spread: 2 of 6 at the
+    floor, every one improved by at least 15 % and within 4.5 x the floor.
     """
     ratios, gains = [], []
-    for seed in range(5, 17):
+    for seed in range(5, 11):
         d = diagnose(synthetic('stiction', seed=seed), settings=FAST)
         assert d.verdict == 'stiction', d.report()
         ratios.append(d.final.er_holdout_percent / d.noise_floor_percent)
         gains.append(1.0 - d.final.er_holdout_percent / d.baseline.er_holdout_percent)
     record_property('final_over_floor', [round(r, 3) for r in ratios])
     record_property('holdout_gain', [round(g, 3) for g in gains])
-    assert sum(r < 1.5 for r in ratios) >= 3, np.round(ratios, 2)
+    assert sum(r < 1.5 for r in ratios) >= 2, np.round(ratios, 2)
     assert max(ratios) < 4.5, np.round(ratios, 2)
     assert min(gains) > 0.15, np.round(gains, 2)
 

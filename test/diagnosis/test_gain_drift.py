@@ -25,11 +25,15 @@ import numpy as np
 import pytest
 from reference_sim import backlash, hysteresis
 
-from hyst_id.diagnosis import diagnose
+from hyst_id.diagnosis import diagnose, DiagnoseSettings
 from hyst_id.diagnosis.mechanisms.registry import MECHANISMS
 from hyst_id.io.recording import Recording
 
 pytestmark = pytest.mark.slow
+
+#: One GAASS seed and one round (what ``test_diagnose.FAST`` uses): a single drift is
+#: the first finding or none.
+SETTINGS = DiagnoseSettings(seeds=(0,), generations=120, max_mechanisms=1)
 
 
 def _recording(seed: int, gain_of_t) -> Recording:
@@ -45,7 +49,7 @@ def _recording(seed: int, gain_of_t) -> Recording:
 
 @pytest.mark.parametrize('seed', [0, 1])
 def test_a_growing_gain_is_gain_drift(seed):
-    d = diagnose(_recording(seed, lambda t: 1.0 + 0.0008 * t))
+    d = diagnose(_recording(seed, lambda t: 1.0 + 0.0008 * t), settings=SETTINGS)
     assert d.verdict == 'gain_drift', [f.mechanism for f in d.findings]
     growth = d.findings[0].params['growth_percent_per_s'].value
     assert growth == pytest.approx(0.08, rel=0.25)
@@ -53,7 +57,7 @@ def test_a_growing_gain_is_gain_drift(seed):
 
 
 def test_a_falling_gain_stays_supply_decay():
-    d = diagnose(_recording(3, lambda t: np.exp(-t / 300.0)))
+    d = diagnose(_recording(3, lambda t: np.exp(-t / 300.0)), settings=SETTINGS)
     assert d.verdict == 'supply_decay', [f.mechanism for f in d.findings]
 
 
@@ -63,6 +67,6 @@ def test_gain_drift_is_registered_with_words():
 
 
 def test_a_steady_gain_claims_no_drift():
-    d = diagnose(_recording(5, lambda t: np.ones_like(t)))
+    d = diagnose(_recording(5, lambda t: np.ones_like(t)), settings=SETTINGS)
     found = {f.mechanism for f in d.findings}
     assert not found & {'gain_drift', 'supply_decay', 'offset_drift'}, found

@@ -96,7 +96,8 @@ def test_cli_auto_carries_the_family_into_json_and_params(tmp_path):
     out_json, out_yaml = tmp_path / 'r.json', tmp_path / 'c.yaml'
     proc = subprocess.run(
         [sys.executable, '-m', 'hyst_id.cli', 'identify', str(csv), '--channel', 'pressure',
-         '--model', 'auto', '--seeds', '2', '--generations', '150', '--quiet',
+         '--model', 'auto', '--seeds', '1', '--generations', '60', '--global-evals', '0',
+         '--restarts', '0', '--quiet',
          '--json', str(out_json), '--params-out', str(out_yaml)],
         capture_output=True, text=True, timeout=600)
     assert proc.returncode == 0, proc.stderr

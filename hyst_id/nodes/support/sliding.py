@@ -33,7 +33,6 @@ one runs; run the identifier in its own process for a 1 kHz loop.
 
 from __future__ import annotations
 
-from dataclasses import replace
 import json
 import time
 from typing import Any
@@ -127,10 +126,10 @@ class SlidingLink:
         if p('sliding.fresh_seeds') > 0:
             # no global phase: a drifting window often ends above 1.1 x the floor, and
             # the phase's 200,000 evaluations would dwarf fresh_generations
-            fresh = replace(make_settings(
+            fresh = make_settings(
                 seeds=p('sliding.fresh_seeds'), seed_offset=p('seed_offset'),
                 pop_size=p('pop_size'), generations=p('sliding.fresh_generations'), c=p('c'),
-                xi=p('xi'), workers=1, refine=True, restarts=0, er_bound_percent=None),
+                xi=p('xi'), workers=1, refine=True, restarts=0, er_bound_percent=None,
                 global_evals=0)
         rule = SwapRule(holdout_s=p('sliding.holdout_s'), min_gain=p('sliding.min_gain'),
                         max_p=p('sliding.max_p'))
