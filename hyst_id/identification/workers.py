@@ -82,8 +82,20 @@ def _worker_init(parent_pid: int) -> None:
 
 
 def _end(pool: ProcessPoolExecutor) -> None:
-    """Stop ``pool`` now: drop queued tasks and terminate the running workers."""
+    """Stop ``pool`` now: drop queued tasks and terminate the running workers.
+
+    The executor's task queue is fed by a thread that can be blocked writing
+    a task into the pipe to the workers; once they are gone nobody reads it,
+    and on Linux CPython 3.11 only closes that pipe when it notices a broken
+    pool first (``terminate_broken``), not on the shutdown path. The queue's
+    thread is therefore not waited for and the pipe's read end is closed here
+    (a write then fails instead of blocking the interpreter's exit: one hang
+    in a full CI run under load).
+    """
     processes = list(getattr(pool, '_processes', {}).values())
+    call_queue = getattr(pool, '_call_queue', None)
+    if call_queue is not None:
+        call_queue.cancel_join_thread()
     pool.shutdown(wait=False, cancel_futures=True)
     for proc in processes:
         if proc.is_alive():
@@ -92,6 +104,12 @@ def _end(pool: ProcessPoolExecutor) -> None:
         proc.join(2.0)
         if proc.is_alive():
             proc.kill()
+    reader = getattr(call_queue, '_reader', None)
+    if reader is not None:
+        try:
+            reader.close()
+        except OSError:  # pragma: no cover - already closed by the executor
+            pass
 
 
 @contextmanager

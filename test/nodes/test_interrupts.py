@@ -101,7 +101,8 @@ def test_stops_are_clean(node, ros_domain, tmp_path):
 
 
 _WORKER_SCRIPT = r"""
-import sys, numpy as np
+import faulthandler, signal, sys, numpy as np
+faulthandler.register(signal.SIGUSR1, all_threads=True)
 from hyst_id.identification import identify, IdentifySettings
 from hyst_id.identification.chains import chain_spec
 from hyst_id.io.recording import Recording
@@ -156,7 +157,14 @@ def orphans_after(sig: int, tag_value: str) -> int:
         if proc.stdout.readline().strip() != b'start' or not _children_running(tag, 60.0):
             return -1
         proc.send_signal(sig)
-        proc.wait(20)
+        try:
+            proc.wait(20)
+        except subprocess.TimeoutExpired:
+            proc.send_signal(signal.SIGUSR1)        # every thread's stack, for the report
+            time.sleep(1.0)
+            proc.kill()
+            stacks = proc.stdout.read().decode(errors='replace')[-4000:]
+            raise AssertionError(f'no exit 20 s after {sig!r}; threads:\n{stacks}') from None
         deadline = time.monotonic() + 10.0
         while _tagged(tag) and time.monotonic() < deadline:
             time.sleep(0.1)
