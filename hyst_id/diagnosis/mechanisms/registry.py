@@ -22,6 +22,7 @@ in :data:`MODULES` below (see ``docs/diagnosis.md``, "Adding a mechanism").
 from __future__ import annotations
 
 from hyst_id.diagnosis.mechanisms import (
+    creep,
     dead_time,
     gain_drift,
     loop_shape,
@@ -41,7 +42,7 @@ __all__ = ['MECHANISMS', 'MECHANISM_IDS', 'Context', 'Mechanism', 'Quantity', 'g
 #: Every mechanism by id, in the issue's order.
 MECHANISMS: dict[str, Mechanism] = {m.MECHANISM.id: m.MECHANISM for m in (
     dead_time, sensor_lag, supply_decay, offset_drift, saturation, stiction,
-    static_nonlinearity, rate_dependence, loop_shape, gain_drift)}
+    static_nonlinearity, rate_dependence, loop_shape, gain_drift, creep)}
 
 #: The ids alone.
 MECHANISM_IDS = tuple(MECHANISMS)
