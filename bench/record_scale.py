@@ -14,10 +14,13 @@
 
 """Identify and diagnose wall time against record length, the growth exponent, stage profile.
 
-Clean position recordings at 1 kHz from the independent reference simulator
-(``test/reference_sim``: the paper's loop, backlash 0.25, Eq. 24's 10 s sine
-with its decaying amplitude repeated, 0.4 % of the span of noise), of
-``--lengths`` samples (at least 20,000: a shorter 1 kHz record has fewer
+First, identify with its search on a subset of a long record (the default
+``search_samples``) against every sample (``search_samples=0``), on position
+and on pressure (a 0.8 s first-order sensor): wall time and the ratio of the
+two %e_r. Then clean position recordings at 1 kHz from the independent
+reference simulator (``test/reference_sim``: the paper's loop, backlash
+0.25, Eq. 24's 10 s sine with its decaying amplitude repeated, 0.4 % of the
+span of noise), of ``--lengths`` samples (at least 20,000: a shorter 1 kHz record has fewer
 than two of the 10 s sine's reversals). For each: ``identify`` with default
 settings (as ``hyst-id identify``) and ``diagnose`` with default settings
 (both compiled on a short record first), wall time and
@@ -26,7 +29,8 @@ log time on log length) and, for the longest record, where identify's time
 goes (cProfile, one worker so that everything runs in this process).
 
 Usage: ``PYTHONPATH=.:test python bench/record_scale.py [--lengths 20000 60000 120000]
-[--no-diagnose] [--no-profile]``. Run on an otherwise idle machine: it measures time.
+[--no-diagnose] [--no-profile] [--no-full-rate]``. Run on an otherwise idle machine: it
+measures time (about 8 minutes on 2 cores).
 """
 
 from __future__ import annotations
@@ -43,7 +47,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / 'test'))
 
-from reference_sim import backlash, hysteresis  # noqa: E402, I100
+from reference_sim import backlash, first_order_sensor, hysteresis  # noqa: E402, I100
 
 PAPER_H = (1.01, 1.05, 0.10, 0.15, -0.25, 0.50, 14.0, 7.0)
 #: Functions whose cumulative time makes identify's stages (cProfile names).
@@ -54,16 +58,21 @@ STAGES = {'validate_recording': 'validate', 'roundoff_probe': 'round-off probe',
           'assess': 'warnings / uncertainty'}
 
 
-def make_recording(n: int, dt_s: float = 0.001, seed: int = 0):
-    """A clean position recording of ``n`` samples at ``1/dt_s`` Hz (reference simulator)."""
+def make_recording(n: int, dt_s: float = 0.001, seed: int = 0, channel: str = 'position'):
+    """A clean recording of ``n`` samples at ``1/dt_s`` Hz (reference simulator).
+
+    ``channel`` ``pressure``: the position through a first-order sensor of 0.8 s.
+    """
     from hyst_id.io.recording import Recording
     t = np.arange(n) * dt_s
     phase = t % 100.0            # Eq. 24 over 100 s, repeated
     v = 9.0 + (2.0 * np.exp(-0.01 * phase)) * np.sin(2 * np.pi * phase / 10.0)
     y = backlash(hysteresis(v, *PAPER_H), 1.0, -0.25, 0.25)
+    if channel == 'pressure':
+        y = first_order_sensor(t, y, 0.8)
     sigma = 0.004 * float(np.ptp(y))
     y = y + np.random.default_rng(seed).normal(0.0, sigma, n)
-    return Recording(t, v, y, 'position', 'mA', 'mA-eq', f'reference, {n} samples'), sigma
+    return Recording(t, v, y, channel, 'mA', 'mA-eq', f'reference, {n} samples'), sigma
 
 
 def _floor(rec, sigma: float) -> float:
@@ -92,6 +101,26 @@ def profile_identify(rec) -> list[tuple[str, float]]:
     return [('identify (total)', whole)] + sorted(total.items(), key=lambda kv: -kv[1])
 
 
+def full_rate_table(lengths: list[int]) -> None:
+    """Identify with the search on a subset (default) and on every sample, side by side."""
+    from hyst_id.identification import identify, IdentifySettings
+    print('search on a subset (default search_samples) against every sample (0):\n')
+    print('| channel | samples | subset: s | full rate: s | %e_r subset / full rate |')
+    print('|---|---|---|---|---|')
+    for channel in ('position', 'pressure'):
+        for n in lengths:
+            rec = make_recording(n, channel=channel)[0]
+            out = []
+            for samples in (IdentifySettings().search_samples, 0):
+                t0 = time.perf_counter()
+                ident = identify(rec, settings=replace(IdentifySettings(),
+                                                       search_samples=samples))
+                out.append((time.perf_counter() - t0, ident.er_percent))
+            print(f'| {channel} | {n} | {out[0][0]:.1f} | {out[1][0]:.1f} | '
+                  f'{out[0][1] / out[1][1]:.4f} |', flush=True)
+    print()
+
+
 def main(argv: list[str] | None = None) -> int:
     """Print the table, the exponents and the profile."""
     from hyst_id.diagnosis import diagnose
@@ -100,11 +129,15 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument('--lengths', type=int, nargs='+', default=[20_000, 60_000, 120_000])
     ap.add_argument('--no-diagnose', action='store_true')
     ap.add_argument('--no-profile', action='store_true')
+    ap.add_argument('--no-full-rate', action='store_true',
+                    help='skip the full-rate comparison (search_samples=0)')
     args = ap.parse_args(argv)
     warm = make_recording(2000, dt_s=0.05)[0]      # compile the kernels first
     identify(warm)
     if not args.no_diagnose:
         diagnose(warm)
+    if not args.no_full_rate:
+        full_rate_table(args.lengths)
     rows = []
     print('| samples | identify [s] | %e_r / true floor | diagnose [s] | verdict |')
     print('|---|---|---|---|---|')

@@ -51,8 +51,7 @@ from hyst_id.signals.noise import noise_floor_percent
 from hyst_id.solvers.gaass import GaassSolver
 
 __all__ = ['choose_conventions', 'data_incumbent', 'global_phase', 'identify', 'rank_conventions',
-           'run_seed',
-           'summarise']
+           'run_seed', 'search_subset', 'summarise']
 
 
 def run_seed(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray, measurement: np.ndarray,
@@ -93,12 +92,16 @@ def _run_seed(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray, measurement
               incumbent: tuple[np.ndarray, float, int] | None = None,
               alternates: tuple[ChainSpec, ...] = ()) -> SeedRun:
     specs = (spec,) + tuple(alternates)
-    costs = [s.cost_function(t_s, command, measurement) for s in specs]
+    sub = search_subset(command, settings.search_samples) if settings.refine else None
+    search = (t_s, command, measurement) if sub is None else \
+        (t_s[sub], command[sub], measurement[sub])
+    costs = [s.cost_function(*search) for s in specs]
     best_spec = spec
     sum_sq = float(np.sum(measurement ** 2))
     target = None
     if settings.er_bound_percent is not None:
         target = (settings.er_bound_percent / 100.0) ** 2 * sum_sq
+    search_target = None if target is None else target * float(np.sum(search[2] ** 2)) / sum_sq
     good_enough = (settings.restart_factor * floor_percent / 100.0) ** 2 * sum_sq
     best_x, best_fun, er_ga, nfev, nit, history, message = None, np.inf, np.nan, 0, 0, None, ''
     if incumbent is not None:
@@ -110,15 +113,15 @@ def _run_seed(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray, measurement
         here, cost = specs[which], costs[which]
         solver = GaassSolver(cost, here.bounds, feasible=here.feasible,
                              pop_size=settings.pop_size, maxiter=settings.maxiter, c=settings.c,
-                             xi=settings.xi, target=target, rng=rng,
-                             callback=_report(on_generation, seed, restart, measurement))
+                             xi=settings.xi, target=search_target, rng=rng,
+                             callback=_report(on_generation, seed, restart, search[2]))
         res = solver.solve()
         nfev += int(res.nfev)
         nit += int(res.nit)
         if restart == 0:
-            er_ga = float(er_percent(res.fun, measurement))
+            er_ga = float(er_percent(res.fun, search[2]))
             history, message = np.asarray(res.history.best_fun, dtype=float), str(res.message)
-        candidates = [(np.asarray(res.x, dtype=float), float(res.fun))]
+        candidates = [(np.asarray(res.x, dtype=float), float(res.fun))]  # refine off: all data
         if settings.refine:
             candidates = []
             for x0 in _distinct_best(res.population, res.population_fun, settings.refine_top):
@@ -170,8 +173,11 @@ def data_incumbent(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray,
         if not starts:
             return None
         short, nfev = [], 0
+        sub = search_subset(command, settings.search_samples)
+        search = (t_s, command, measurement) if sub is None else \
+            (t_s[sub], command[sub], measurement[sub])
         for x0 in starts:
-            x, fun, k = refine(spec, x0, t_s, command, measurement,
+            x, fun, k = refine(spec, x0, *search,
                                max_nfev=_SHORT_POLISH * (spec.n_params + 1), restarts=0)
             nfev += k
             short.append((fun, x))
@@ -184,6 +190,33 @@ def data_incumbent(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray,
             if fun < best_fun:
                 best_x, best_fun = x, fun
     return (best_x, float(best_fun), nfev) if best_x is not None else None
+
+
+def search_subset(command: np.ndarray, max_samples: int) -> np.ndarray | None:
+    """Indices of a search subset of a long record, or None to use every sample.
+
+    Every ``k``-th sample (``k`` from ``max_samples``) plus the first and last
+    and every command reversal (the last sample at each extreme),
+    in order. A rate-independent chain (H, B) gives the same output at the
+    kept samples as on the whole record, since between two kept samples the
+    command moves one way; sensor dynamics then see the command held over
+    ``k`` samples, a small change at rates well above the sensor's bandwidth.
+    None when ``max_samples`` is 0, the record is not longer, or the
+    reversals alone would keep more than half of it (a noisy command).
+    """
+    v = np.asarray(command, dtype=float)
+    n = v.size
+    if max_samples <= 0 or n <= max_samples:
+        return None
+    d = np.sign(np.diff(v))
+    moving = np.flatnonzero(d)
+    turns = moving[:-1][d[moving[1:]] != d[moving[:-1]]]
+    turns = moving[np.searchsorted(moving, turns) + 1]     # first sample of the new direction
+    if turns.size > n // 2:
+        return None
+    step = max(2, int(np.ceil(n / max_samples)))
+    keep = np.concatenate([np.arange(0, n, step), turns, [n - 1]])
+    return np.unique(keep)
 
 
 def rank_conventions(spec: ChainSpec, rec: Recording, incumbent: tuple[np.ndarray, float, int],

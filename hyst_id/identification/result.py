@@ -81,6 +81,13 @@ class IdentifySettings:
         0: off.
     global_factor : float
         The floor multiple above which the global phase runs.
+    search_samples : int
+        With refinement on, on a record longer than this the GAASS runs and
+        the short polishes of the data-built starts see about this many
+        samples: every k-th sample plus every command reversal (the loop's
+        memory), :func:`hyst_id.identification.driver.search_subset`. They
+        only search; every refinement, every cost that is compared between
+        seeds and every figure reported uses all samples. 0: always all.
     """
 
     pop_size: int = 10
@@ -100,6 +107,7 @@ class IdentifySettings:
     conventions: str = 'auto'
     global_evals: int = 200000
     global_factor: float = 1.1
+    search_samples: int = 20000
 
 
 @dataclass
