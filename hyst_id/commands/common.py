@@ -69,6 +69,10 @@ def add_settings_arguments(parser: argparse.ArgumentParser) -> None:
                    help='evaluations of the global phase run when the best fit stays above '
                    '1.1 x the noise floor (default 200000; 0 = no global phase: faster, '
                    'but a trapped fit stays trapped)')
+    g.add_argument('--search-samples', type=int, default=20000, metavar='N',
+                   help='on a longer record GAASS searches on every k-th sample plus every '
+                   'command reversal; refinement and results use all samples '
+                   '(default 20000; 0 = search on every sample)')
     g.add_argument('--domains', default='auto', metavar='auto|paper|YAML',
                    help="search domains: derived from the data (auto), the paper's "
                    'preset (paper), or a YAML mapping name: [low, high] that overrides '
@@ -97,7 +101,7 @@ def make_settings(args: argparse.Namespace) -> IdentifySettings:
         seeds=args.seeds, seed_offset=args.seed_offset, pop_size=args.pop_size,
         generations=args.generations, c=args.c, xi=args.xi, workers=args.workers,
         refine=not args.gaass_only, restarts=args.restarts, er_bound_percent=args.er_bound,
-        global_evals=args.global_evals)
+        global_evals=args.global_evals, search_samples=args.search_samples)
 
 
 def make_spec(args: argparse.Namespace, rec: Recording, family: str | None = None) -> ChainSpec:

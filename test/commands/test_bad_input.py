@@ -166,6 +166,8 @@ CASES = [
                                     str(_text(d / 'bad.yaml', 'm_l: [1, \n'))], 'YAML'),
     ('negative-global-evals', lambda d: [str(write_csv(d / 'ok6.csv')), '--global-evals',
                                          '-1'], 'global evaluations'),
+    ('negative-search-samples', lambda d: [str(write_csv(d / 'ok7.csv')), '--search-samples',
+                                           '-5'], 'search samples'),
     ('bad-columns-option', lambda d: [str(write_csv(d / 'ok5.csv')), '--columns', 't,command'],
      'three'),
 ]
