@@ -84,13 +84,13 @@ def _worker_init(parent_pid: int) -> None:
 def _end(pool: ProcessPoolExecutor) -> None:
     """Stop ``pool`` now: drop queued tasks and terminate the running workers.
 
-    The executor's task queue is fed by a thread that can be blocked writing
-    a task into the pipe to the workers; once they are gone nobody reads it,
-    and on Linux CPython 3.11 only closes that pipe when it notices a broken
-    pool first (``terminate_broken``), not on the shutdown path. The queue's
-    thread is therefore not waited for and the pipe's read end is closed here
-    (a write then fails instead of blocking the interpreter's exit: one hang
-    in a full CI run under load).
+    The executor's task queue is fed by a thread that is usually blocked
+    writing the next task into the pipe to the busy workers (seen in every
+    thread dump of a running pool); once they are gone nobody reads it, and
+    on Linux CPython 3.11 closes that pipe only when it notices a broken pool
+    first (``terminate_broken``), not on the shutdown path. So the queue's
+    thread is not waited for and the pipe's read end is closed here: a write
+    then fails instead of being able to hold up the interpreter's exit.
     """
     processes = list(getattr(pool, '_processes', {}).values())
     call_queue = getattr(pool, '_call_queue', None)

@@ -103,6 +103,9 @@ def test_stops_are_clean(node, ros_domain, tmp_path):
 _WORKER_SCRIPT = r"""
 import faulthandler, signal, sys, numpy as np
 faulthandler.register(signal.SIGUSR1, all_threads=True)
+# Ctrl-C as in a terminal: a shell without job control starts background jobs (a CI
+# runner's) with SIGINT ignored, and a child would inherit that
+signal.signal(signal.SIGINT, signal.default_int_handler)
 from hyst_id.identification import identify, IdentifySettings
 from hyst_id.identification.chains import chain_spec
 from hyst_id.io.recording import Recording
