@@ -22,6 +22,7 @@ in :data:`MODULES` below (see ``docs/diagnosis.md``, "Adding a mechanism").
 from __future__ import annotations
 
 from hyst_id.diagnosis.mechanisms import (
+    actuator_dynamics,
     creep,
     dead_time,
     gain_drift,
@@ -42,7 +43,8 @@ __all__ = ['MECHANISMS', 'MECHANISM_IDS', 'Context', 'Mechanism', 'Quantity', 'g
 #: Every mechanism by id, in the issue's order.
 MECHANISMS: dict[str, Mechanism] = {m.MECHANISM.id: m.MECHANISM for m in (
     dead_time, sensor_lag, supply_decay, offset_drift, saturation, stiction,
-    static_nonlinearity, rate_dependence, loop_shape, gain_drift, creep)}
+    static_nonlinearity, rate_dependence, loop_shape, gain_drift, creep,
+    actuator_dynamics)}
 
 #: The ids alone.
 MECHANISM_IDS = tuple(MECHANISMS)
