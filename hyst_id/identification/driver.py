@@ -124,7 +124,16 @@ def _run_seed(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray, measurement
         candidates = [(np.asarray(res.x, dtype=float), float(res.fun))]  # refine off: all data
         if settings.refine:
             candidates = []
-            for x0 in _distinct_best(res.population, res.population_fun, settings.refine_top):
+            starts = _distinct_best(res.population, res.population_fun, settings.refine_top)
+            if sub is not None:         # polish all on the subset, the best on every sample
+                polished = []
+                for x0 in starts:
+                    x_sub, fun_sub, nfev_ref = refine(here, x0, *search,
+                                                      max_nfev=settings.refine_max_nfev)
+                    nfev += nfev_ref
+                    polished.append((fun_sub, x_sub))
+                starts = [min(polished, key=lambda z: z[0])[1]]
+            for x0 in starts:
                 x_ref, fun_ref, nfev_ref = refine(here, x0, t_s, command, measurement,
                                                   max_nfev=settings.refine_max_nfev)
                 nfev += nfev_ref
@@ -176,14 +185,25 @@ def data_incumbent(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray,
         sub = search_subset(command, settings.search_samples)
         search = (t_s, command, measurement) if sub is None else \
             (t_s[sub], command[sub], measurement[sub])
+        # the short polishes only rank the starts: a quarter of the subset on a long record
+        few = search_subset(command, settings.search_samples // 4) if sub is not None else None
+        ranking = search if few is None else (t_s[few], command[few], measurement[few])
         for x0 in starts:
-            x, fun, k = refine(spec, x0, *search,
+            x, fun, k = refine(spec, x0, *ranking,
                                max_nfev=_SHORT_POLISH * (spec.n_params + 1), restarts=0)
             nfev += k
             short.append((fun, x))
         short.sort(key=lambda z: z[0])
+        finalists = [x0 for _, x0 in short[:2]]
+        if sub is not None:             # polish both on the subset, the better on all samples
+            polished = []
+            for x0 in finalists:
+                x, fun, k = refine(spec, x0, *search, max_nfev=settings.refine_max_nfev)
+                nfev += k
+                polished.append((fun, x))
+            finalists = [min(polished, key=lambda z: z[0])[1]]
         best_x, best_fun = None, np.inf
-        for _, x0 in short[:2]:
+        for x0 in finalists:
             x, fun, k = refine(spec, x0, t_s, command, measurement,
                                max_nfev=settings.refine_max_nfev)
             nfev += k

@@ -82,12 +82,14 @@ class IdentifySettings:
     global_factor : float
         The floor multiple above which the global phase runs.
     search_samples : int
-        With refinement on, on a record longer than this the GAASS runs and
-        the short polishes of the data-built starts see about this many
-        samples: every k-th sample plus every command reversal (the loop's
-        memory), :func:`hyst_id.identification.driver.search_subset`. They
-        only search; every refinement, every cost that is compared between
-        seeds and every figure reported uses all samples. 0: always all.
+        With refinement on, on a record longer than this the GAASS runs, the
+        polishes of each run's best chromosomes and of the data-built starts
+        see about this many samples: every k-th sample plus every command
+        reversal (the loop's memory),
+        :func:`hyst_id.identification.driver.search_subset`; the best of each
+        group is then polished on all samples, and every cost compared
+        between seeds and every figure reported uses all samples. 0: always
+        all.
     """
 
     pop_size: int = 10
