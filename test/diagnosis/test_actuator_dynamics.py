@@ -21,6 +21,7 @@ between random levels and holds, so the travel rings after each move.
 
 from __future__ import annotations
 
+from excitations import moves_and_holds
 import numpy as np
 import pytest
 from reference_sim import backlash, first_order_sensor, hysteresis, second_order_sensor
@@ -38,11 +39,7 @@ def _recording(seed: int, zeta: float | None, omega_n: float = 2.5,
                lag_s: float | None = None) -> Recording:
     rng = np.random.default_rng(seed)
     t = np.arange(2400) * 0.05
-    levels = rng.uniform(6.0, 12.5, 20)
-    seg = np.minimum((t // 6.0).astype(int), levels.size - 1)
-    prev = np.concatenate([[9.0], levels[:-1]])[seg]
-    frac = np.clip((t % 6.0) / 0.5, 0.0, 1.0)
-    v = prev + (levels[seg] - prev) * frac
+    v = moves_and_holds(rng, t, dwell_s=6.0, move_s=0.5, n_levels=20)
     x = backlash(hysteresis(v, 1.01, 1.05, 0.10, 0.15, -0.25, 0.50, 14.0, 7.0), 1.0,
                  -0.15, 0.15)
     if zeta is not None:

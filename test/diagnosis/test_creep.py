@@ -21,6 +21,7 @@ holds (as a hold test would), so the slow part shows after every move.
 
 from __future__ import annotations
 
+from excitations import moves_and_holds
 import numpy as np
 import pytest
 from reference_sim import backlash, first_order_sensor, hysteresis
@@ -37,12 +38,7 @@ SETTINGS = DiagnoseSettings(seeds=(0,), generations=120, max_mechanisms=1)
 def _recording(seed: int, share: float, tau_s: float = 12.0) -> Recording:
     rng = np.random.default_rng(seed)
     t = np.arange(3000) * 0.05
-    # moves of 2 s between random levels, held for 8 s
-    levels = rng.uniform(6.0, 12.5, 16)
-    seg = np.minimum((t // 10.0).astype(int), levels.size - 1)
-    prev = np.concatenate([[9.0], levels[:-1]])[seg]
-    frac = np.clip((t % 10.0) / 2.0, 0.0, 1.0)
-    v = prev + (levels[seg] - prev) * frac
+    v = moves_and_holds(rng, t, dwell_s=10.0, move_s=2.0, n_levels=16)
     x = backlash(hysteresis(v, 1.01, 1.05, 0.10, 0.15, -0.25, 0.50, 14.0, 7.0), 1.0,
                  -0.15, 0.15)
     x = (1.0 - share) * x + share * first_order_sensor(t, x, tau_s)

@@ -35,7 +35,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from hyst_id.diagnosis.mechanisms.base import Context, Mechanism, Quantity
+from hyst_id.diagnosis.mechanisms.base import Context, Mechanism, Quantity, rate_correlation
 from hyst_id.models.sensors import simulate_second_order
 
 __all__ = ['ActuatorDynamics', 'MECHANISM']
@@ -109,9 +109,7 @@ class ActuatorDynamics(Mechanism):
 
     def evidence(self, loc) -> tuple[float, dict]:
         """A residual correlated with the command rate (ringing is decided held-out)."""
-        return 0.5 * float(loc.ccf_rate['significant']), {
-            'correlation_with_rate': {'r': loc.ccf_rate['peak_r'],
-                                      'lag_s': loc.ccf_rate['peak_lag_s']}}
+        return 0.5 * float(loc.ccf_rate['significant']), rate_correlation(loc)
 
     def compensation_note(self, values, ctx) -> str:
         """H^-1 is static: the dynamics stay."""

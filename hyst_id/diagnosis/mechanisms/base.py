@@ -40,7 +40,8 @@ from typing import Any, Sequence
 
 import numpy as np
 
-__all__ = ['COMPENSATION_KINDS', 'STAGES', 'Context', 'Mechanism', 'Quantity', 'clip_theta']
+__all__ = ['COMPENSATION_KINDS', 'STAGES', 'Context', 'Mechanism', 'Quantity', 'clip_theta',
+           'rate_correlation']
 
 #: How a block is made up for in operation: by the compensator's tracking or the
 #: identifier's sliding re-identification; by the command limits; by identifying
@@ -261,3 +262,9 @@ def clip_theta(theta: Sequence[float], bounds: np.ndarray) -> np.ndarray:
     lo, hi = bounds[:, 0], bounds[:, 1]
     eps = 1e-9 * np.maximum(1.0, np.abs(hi - lo))
     return np.minimum(np.maximum(t, lo + eps), hi - eps)
+
+
+def rate_correlation(loc: Any) -> dict:
+    """Where-evidence of a residual correlated with the command rate (peak r and its lag)."""
+    return {'correlation_with_rate': {'r': loc.ccf_rate['peak_r'],
+                                      'lag_s': loc.ccf_rate['peak_lag_s']}}

@@ -39,7 +39,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from hyst_id.diagnosis.mechanisms.base import Context, Mechanism, Quantity
+from hyst_id.diagnosis.mechanisms.base import Context, Mechanism, Quantity, rate_correlation
 from hyst_id.models.sensors import simulate_first_order
 
 __all__ = ['Creep', 'MECHANISM']
@@ -110,8 +110,7 @@ class Creep(Mechanism):
         f = loc.features
         score = 0.5 * float(loc.ccf_rate['significant'])
         score += 0.5 * float(np.clip(f['low_fraction'], 0.0, 1.0))
-        return score, {'correlation_with_rate': {'r': loc.ccf_rate['peak_r'],
-                                                 'lag_s': loc.ccf_rate['peak_lag_s']}}
+        return score, rate_correlation(loc)
 
     def compensation_note(self, values, ctx) -> str:
         """H^-1 does not invert a history-dependent slow part."""

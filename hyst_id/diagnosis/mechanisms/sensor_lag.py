@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from hyst_id.diagnosis.mechanisms.base import Context, Mechanism, Quantity
+from hyst_id.diagnosis.mechanisms.base import Context, Mechanism, Quantity, rate_correlation
 from hyst_id.models.sensors import simulate_first_order
 
 __all__ = ['SensorLag', 'MECHANISM']
@@ -96,8 +96,7 @@ class SensorLag(Mechanism):
         f = loc.features
         score = 0.5 * float(loc.ccf_rate['significant'])
         score += 0.5 * float(np.clip(1.0 - abs(f['early_late_ratio'] - 1.5), 0.0, 1.0))
-        return score, {'correlation_with_rate': {'r': loc.ccf_rate['peak_r'],
-                                                 'lag_s': loc.ccf_rate['peak_lag_s']}}
+        return score, rate_correlation(loc)
 
     def compensation_note(self, values, ctx) -> str:
         """The lag is in the reading, not in the actuator."""
