@@ -19,10 +19,17 @@ A bag holds two message streams that the reader pairs
 time base and each gets the last command at or before its stamp (the DAC
 holds a command until the next one); out-of-order stamps are sorted and
 duplicate stamps dropped, each with a note in ``Recording.notes``.
+
+Memory: messages are decoded one at a time (the bag is never loaded whole)
+and their stamps and values go into typed buffers (:class:`array.array`,
+8 bytes a number, where a list of Python numbers costs about 32), handed to
+numpy without a copy; ``bench/bag_memory.py`` prints the peak against the
+size of the arrays read.
 """
 
 from __future__ import annotations
 
+from array import array
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -38,13 +45,14 @@ from hyst_id.io.topics import get_field, parse_field_path, TopicConfig
 __all__ = ['read_mcap']
 
 
-def _collect(bag: Any, cfg: TopicConfig) -> dict[str, tuple[list[int], list[float]]]:
-    """Read stamps and values of the command and measurement topics."""
+def _collect(bag: Any, cfg: TopicConfig) -> dict[str, tuple[array, array, array]]:
+    """Stamps, values and log times of the command and measurement topics (typed buffers)."""
     spec = {cfg.command_topic: (parse_field_path(cfg.command_field), cfg.command_field,
                                 cfg.command_type),
             cfg.measurement_topic: (parse_field_path(cfg.measurement_field),
                                     cfg.measurement_field, cfg.measurement_type)}
-    out: dict[str, tuple[list[int], list[float], list[int]]] = {t: ([], [], []) for t in spec}
+    out: dict[str, tuple[array, array, array]] = {
+        t: (array('q'), array('d'), array('q')) for t in spec}
     for topic, msgtype, log_ns, msg in bag.messages(list(spec)):
         tokens, field_path, expected = spec[topic]
         try:
@@ -108,12 +116,12 @@ def read_mcap(path: str | Path, channel: str, topics: TopicConfig | Mapping | No
     for topic, (stamps, values, log_ns) in streams.items():
         if not stamps:
             raise RecordingError(f'topic {topic} in {path} has no messages')
-        t_ns = np.asarray(stamps, dtype=np.int64)
+        t_ns = np.frombuffer(stamps, dtype=np.int64)
         if (t_ns == 0).any():
             notes.append(f'{topic}: {int((t_ns == 0).sum())} messages without header.stamp; '
                          f'used log times for the whole topic')
-            t_ns = np.asarray(log_ns, dtype=np.int64)
-        arrays[topic] = (t_ns, np.asarray(values, dtype=float))
+            t_ns = np.frombuffer(log_ns, dtype=np.int64)
+        arrays[topic] = (t_ns, np.frombuffer(values, dtype=np.float64))
     cmd_t, cmd_v = arrays[cfg.command_topic]
     meas_t, meas_v = arrays[cfg.measurement_topic]
     return pair_streams(cmd_t, cmd_v, meas_t, meas_v, channel,
