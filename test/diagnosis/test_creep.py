@@ -51,7 +51,7 @@ def _recording(seed: int, share: float, tau_s: float = 12.0) -> Recording:
 def test_a_slow_share_of_the_travel_is_creep(seed):
     """Named with its time constant and share, and the held-out error at the floor.
 
-    Measured on noise seeds 0-7: named 8/8, tau 11.72-12.13 s, share 11.90-12.21 %,
+    Measured on noise seeds 0-7: named 8/8, tau 11.72-12.14 s, share 11.90-12.21 %,
     final held-out 0.975-1.131 x the floor. The bounds sit outside that spread.
     """
     d = diagnose(_recording(seed, 0.12), settings=SETTINGS)
