@@ -126,13 +126,8 @@ def _run_seed(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray, measurement
             candidates = []
             starts = _distinct_best(res.population, res.population_fun, settings.refine_top)
             if sub is not None:         # polish all on the subset, the best on every sample
-                polished = []
-                for x0 in starts:
-                    x_sub, fun_sub, nfev_ref = refine(here, x0, *search,
-                                                      max_nfev=settings.refine_max_nfev)
-                    nfev += nfev_ref
-                    polished.append((fun_sub, x_sub))
-                starts = [min(polished, key=lambda z: z[0])[1]]
+                x_sub, nfev_sub = _best_polished(here, starts, search, settings.refine_max_nfev)
+                starts, nfev = [x_sub], nfev + nfev_sub
             for x0 in starts:
                 x_ref, fun_ref, nfev_ref = refine(here, x0, t_s, command, measurement,
                                                   max_nfev=settings.refine_max_nfev)
@@ -196,12 +191,8 @@ def data_incumbent(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray,
         short.sort(key=lambda z: z[0])
         finalists = [x0 for _, x0 in short[:2]]
         if sub is not None:             # polish both on the subset, the better on all samples
-            polished = []
-            for x0 in finalists:
-                x, fun, k = refine(spec, x0, *search, max_nfev=settings.refine_max_nfev)
-                nfev += k
-                polished.append((fun, x))
-            finalists = [min(polished, key=lambda z: z[0])[1]]
+            x_sub, nfev_sub = _best_polished(spec, finalists, search, settings.refine_max_nfev)
+            finalists, nfev = [x_sub], nfev + nfev_sub
         best_x, best_fun = None, np.inf
         for x0 in finalists:
             x, fun, k = refine(spec, x0, t_s, command, measurement,
@@ -210,6 +201,17 @@ def data_incumbent(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray,
             if fun < best_fun:
                 best_x, best_fun = x, fun
     return (best_x, float(best_fun), nfev) if best_x is not None else None
+
+
+def _best_polished(spec: ChainSpec, starts: list[np.ndarray], data: tuple, max_nfev: int
+                   ) -> tuple[np.ndarray, int]:
+    """The best of ``starts`` each refined on ``data`` (a search subset), and the evaluations."""
+    polished, nfev = [], 0
+    for x0 in starts:
+        x, fun, k = refine(spec, x0, *data, max_nfev=max_nfev)
+        nfev += k
+        polished.append((fun, x))
+    return min(polished, key=lambda z: z[0])[1], nfev
 
 
 def search_subset(command: np.ndarray, max_samples: int) -> np.ndarray | None:
@@ -231,7 +233,7 @@ def search_subset(command: np.ndarray, max_samples: int) -> np.ndarray | None:
     d = np.sign(np.diff(v))
     moving = np.flatnonzero(d)
     turns = moving[:-1][d[moving[1:]] != d[moving[:-1]]]
-    turns = moving[np.searchsorted(moving, turns) + 1]     # first sample of the new direction
+    turns = moving[np.searchsorted(moving, turns) + 1]     # the extreme: the new way starts
     if turns.size > n // 2:
         return None
     step = max(2, int(np.ceil(n / max_samples)))

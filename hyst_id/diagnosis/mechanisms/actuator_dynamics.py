@@ -17,7 +17,7 @@
 Placement: between the static loop and the travel, ``x = G(s) B(H(v))`` with
 ``G = w^2 / (s^2 + 2 zeta w s + w^2)``: a moving mass on a spring (valve
 stem and diaphragm, a piezo stack with its load) that overshoots and rings
-after a fast move, or creeps in when overdamped. ``G`` is linear and so are
+after a fast move (underdamped only, see below). ``G`` is linear and so are
 the sensor dynamics and the calibration, so the block is evaluated on the
 sensor's output (the same product of transfer functions). Parameters:
 ``zeta`` (1) and ``omega_n_rad_s`` (rad/s).
@@ -89,7 +89,7 @@ class ActuatorDynamics(Mechanism):
     def describe(self, theta, coef, info, ctx) -> dict[str, Quantity]:
         """Damping, natural frequency in rad/s and Hz, overshoot to a step."""
         zeta, omega = float(theta[0]), float(theta[1])
-        overshoot = 100.0 * np.exp(-np.pi * zeta / np.sqrt(1.0 - zeta ** 2)) if zeta < 1 else 0.0
+        overshoot = 100.0 * np.exp(-np.pi * zeta / np.sqrt(1.0 - zeta ** 2))   # zeta <= 0.7
         return {'zeta': Quantity(zeta, '1', 'damping ratio'),
                 'omega_n_rad_s': Quantity(omega, 'rad/s', 'natural frequency'),
                 'f_n_hz': Quantity(omega / (2.0 * np.pi), 'Hz', 'natural frequency'),

@@ -74,9 +74,7 @@ class Creep(Mechanism):
     def starts(self, ctx: Context) -> list[np.ndarray]:
         """Log-spaced from half a loop period to the upper bound."""
         lo, hi = self.bounds(ctx)[0]
-        a = max(lo, 0.5 * ctx.period_s)
-        b = min(hi, max(a * 1.5, hi))
-        return [np.array([x]) for x in np.geomspace(a, b, 4)]
+        return [np.array([x]) for x in np.geomspace(max(lo, 0.5 * ctx.period_s), hi, 4)]
 
     def null(self, ctx: Context) -> np.ndarray:
         """The slowest lag (its share then acts almost as an offset)."""
