@@ -48,6 +48,7 @@ from hyst_id.identification.starts import data_starts
 from hyst_id.identification.workers import map_in_processes
 from hyst_id.io.recording import Recording, roundoff_probe, validate_recording
 from hyst_id.signals.noise import noise_floor_percent
+from hyst_id.signals.reversals import reversal_indices
 from hyst_id.solvers.gaass import GaassSolver
 
 __all__ = ['choose_conventions', 'data_incumbent', 'global_phase', 'identify', 'rank_conventions',
@@ -218,9 +219,10 @@ def search_subset(command: np.ndarray, max_samples: int) -> np.ndarray | None:
     """Indices of a search subset of a long record, or None to use every sample.
 
     Every ``k``-th sample (``k`` from ``max_samples``) plus the first and last
-    and every command reversal (the last sample at each extreme),
-    in order. A rate-independent chain (H, B) gives the same output at the
-    kept samples as on the whole record, since between two kept samples the
+    and every command reversal (its extreme sample,
+    :func:`hyst_id.signals.reversals.reversal_indices` with no tolerance), in
+    order. A rate-independent chain (H, B) gives the same output at the kept
+    samples as on the whole record, since between two kept samples the
     command moves one way; sensor dynamics then see the command held over
     ``k`` samples, a small change at rates well above the sensor's bandwidth.
     None when ``max_samples`` is 0, the record is not longer, or the
@@ -230,10 +232,7 @@ def search_subset(command: np.ndarray, max_samples: int) -> np.ndarray | None:
     n = v.size
     if max_samples <= 0 or n <= max_samples:
         return None
-    d = np.sign(np.diff(v))
-    moving = np.flatnonzero(d)
-    turns = moving[:-1][d[moving[1:]] != d[moving[:-1]]]
-    turns = moving[np.searchsorted(moving, turns) + 1]     # the extreme: the new way starts
+    turns = reversal_indices(v, tolerance=0.0)[0]
     if turns.size > n // 2:
         return None
     step = max(2, int(np.ceil(n / max_samples)))
