@@ -171,7 +171,7 @@ def test_live_pipeline_then_replay_agrees_with_cli(ros_domain, tmp_path):
         graph.wait_log('recorder', 'recording /hyst_id/position', 30.0)
         graph.start('excite_eq24', 'excitation', '-p', 'profile:=eq24', '-p',
                     'duration_s:=60.0', '-p', 'sample_period_s:=0.1', '-p', 'time_scale:=5.0',
-                    '-p', 'wait_for_subscribers:=4', '-p', 'start_delay_s:=1.5',
+                    '-p', 'wait_for_subscribers:=4', '-p', 'start_delay_s:=3.0',
                     '-p', 'shutdown_when_done:=true')
         assert graph.wait_exit('excite_eq24', 60.0) == 0, graph.log('excite_eq24')
         time.sleep(0.5)
@@ -182,7 +182,12 @@ def test_live_pipeline_then_replay_agrees_with_cli(ros_domain, tmp_path):
         live = obs.wait_doc(1, 90.0)
         print(f'\nlive identification: %e_r {live["er_percent"]:.3f} from '
               f'{live["n_samples"]} samples')
-        assert live['n_samples'] >= 595 and live['er_percent'] < 1.0
+        # 600 commands are sent. DDS discovery is asynchronous and the excitation can only
+        # wait for its own subscribers, so on a loaded CI machine the first samples of the
+        # driver -> identifier link can go before it is matched: 591 was seen once in CI,
+        # 600-601 locally (also with two CPU hogs). What matters is that the run is
+        # identified as one, to well under 1 %; a run split by a stall would be far shorter.
+        assert live['n_samples'] >= 570 and live['er_percent'] < 1.0, graph.log('identifier')
         graph.wait_log('compensator', 'applied parameter set', 20.0)
         assert graph.interrupt('identifier') == 130, graph.log('identifier')
         assert (tmp_path / 'live.yaml').exists()
@@ -237,7 +242,7 @@ def test_live_pipeline_then_replay_agrees_with_cli(ros_domain, tmp_path):
         ref = json.loads(cli_json.read_text())
         print(f'replay identification: %e_r {replayed["er_percent"]:.6f}, '
               f'hyst-id identify: %e_r {ref["er_percent"]:.6f}')
-        assert replayed['n_samples'] >= 595
+        assert replayed['n_samples'] >= 570   # the bag holds what the recorder received
         for name, value in ref['params'].items():
             assert replayed['params'][name] == pytest.approx(value, rel=1e-9, abs=1e-12), name
         assert replayed['er_percent'] == pytest.approx(ref['er_percent'], rel=1e-9)
