@@ -64,12 +64,12 @@ from hyst_id.diagnosis.select import (
     round_record,
 )
 from hyst_id.errors import ConfigError, RecordingError
-from hyst_id.identification.chains import chain_spec, ChainSpec
+from hyst_id.identification.chains import chain_spec, ChainSpec, HOLDS
 from hyst_id.identification.domains import domains_from_data
 from hyst_id.io.recording import Recording, roundoff_probe, validate_recording
 from hyst_id.signals.noise import floor_percent
 from hyst_id.signals.reversals import period_s
-from hyst_id.signals.split import split_index
+from hyst_id.signals.split import inside_rows, split_index
 
 __all__ = ['UNKNOWN_FACTOR', 'diagnose', 'finding_from', 'located_where', 'range_note']
 
@@ -198,15 +198,21 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
                   command_unit=rec.command_unit, measurement_unit=rec.measurement_unit,
                   extra={'period_s': period_s(t[:n_train], v[:n_train])})
     sigma = noise_std(y)
-    data = Data(t_s=t, v=v, y=y, n_train=n_train, noise_std=sigma)
+    data = Data(t_s=t, v=v, y=y, n_train=n_train, noise_std=sigma,
+                judged=inside_rows(v, n_train))
     say(f'baseline: GAASS x {len(settings.seeds)} seeds on the first {n_train} samples')
-    base_model = ComposedModel(rec.channel, [], ctx, spec.bounds)
     x_ga, starts = baseline_starts(rec_train, spec, settings)
-    polished = sorted((polish(base_model, data, x0, max_nfev=2 * settings.fit_budget) + (x0,)
+    # a channel with a sensor has dynamics from the start: its hold convention is chosen
+    # here, on the training error (a position chain is static until a filter block joins)
+    holds = HOLDS if rec.channel != 'position' else HOLDS[:1]
+    polished = sorted((polish(model, data, x0, max_nfev=2 * settings.fit_budget) + (x0, model)
+                       for model in [ComposedModel(rec.channel, [], ctx, spec.bounds, hold=h)
+                                     for h in holds]
                        for x0 in [x_ga] + starts), key=lambda z: z[1])
-    baseline = evaluate(base_model, data, polished[0][0], polished[0][2])
+    baseline = evaluate(polished[0][4], data, polished[0][0], polished[0][2])
     # the neutral data-built starts whose basins fitted best seed the mechanism fits
-    chain_starts = [z[3] for z in polished if any(z[3] is s for s in starts)][:2]
+    chain_starts = [z[3] for z in polished if any(z[3] is s for s in starts)
+                    and z[4].hold == baseline.model.hold][:2]
     floor_h = floor_percent(y[n_train:], sigma)
     floor_t = floor_percent(y[:n_train], sigma)
     loc0 = locate(t, v_orig, y, baseline.prediction, sigma, n_train, ctx.period_s)
@@ -228,7 +234,7 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
             say(f'round {round_no + 1}: testing {m.id}')
             comps.append(_try(m, current, data, ctx, settings, loc, chain_starts))
         winner, tied = choose(comps, data, settings.criteria)
-        rounds.append(round_record(round_no + 1, comps, winner))
+        rounds.append(round_record(round_no + 1, comps, winner, data))
         if winner is None:
             break
         mech = next(m for m in mechs if m.id == winner.mechanism)
@@ -239,7 +245,7 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
         current = winner.fit
         loc = locate(t, v_orig, y, current.prediction, sigma, n_train, ctx.period_s)
     final_loc = loc if current is not baseline else loc0
-    notes = list(rec.notes) + range_note(v_orig, n_train)
+    notes = list(rec.notes) + range_note(v_orig, n_train, data.judged_rows.size)
     empirical = None
     if current.er_holdout_percent > UNKNOWN_FACTOR * floor_h:
         say('empirical block: what a model could still gain')
@@ -258,18 +264,41 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
                      noise_floor_percent=floor_h, noise_floor_train_percent=floor_t,
                      rounds=rounds, baseline_params=_chain_dict(rec.channel, baseline.p),
                      measurement_unit=rec.measurement_unit, command_unit=rec.command_unit,
-                     notes=notes, extra={'command_scale': list(scale)})
+                     notes=notes, extra={'command_scale': list(scale),
+                                         'hold': current.model.hold
+                                         if current.model.dynamic else '',
+                                         'judged_holdout': _judged(data, baseline, current)})
 
 
-def range_note(v: np.ndarray, n_train: int) -> list[str]:
-    """A warning when the held-out command leaves the training range (extrapolation)."""
+def range_note(v: np.ndarray, n_train: int, n_judged: int | None = None) -> list[str]:
+    """A warning when the held-out command leaves the training range (extrapolation).
+
+    With ``n_judged`` (held-out samples the blocks were judged on, see
+    :func:`hyst_id.signals.split.inside_rows`) the note says which part decided.
+    """
     lo_t, hi_t = float(np.min(v[:n_train])), float(np.max(v[:n_train]))
     lo_h, hi_h = float(np.min(v[n_train:])), float(np.max(v[n_train:]))
     if max(lo_t - lo_h, hi_h - hi_t) > 0.05 * (hi_t - lo_t):
-        return [f'the held-out command reaches {lo_h:.4g} to {hi_h:.4g}, beyond the training '
+        note = (f'the held-out command reaches {lo_h:.4g} to {hi_h:.4g}, beyond the training '
                 f'range {lo_t:.4g} to {hi_t:.4g}: held-out errors there are extrapolation of '
-                'the model, not necessarily missing physics']
+                'the model, not necessarily missing physics')
+        n_ho = v.size - n_train
+        if n_judged is not None and n_judged < n_ho:
+            note += (f'; the blocks were judged on the first {n_judged} of {n_ho} held-out '
+                     'samples, before the command first leaves the training range')
+        return [note]
     return []
+
+
+def _judged(data: Data, baseline: FitResult, final: FitResult) -> dict:
+    """The held-out samples blocks were judged on, and the errors there."""
+    rows = data.judged_rows
+    return {'n_samples': int(rows.size), 'n_holdout': data.n_holdout,
+            'rule': 'held-out samples before the command first leaves the training range '
+                    '(all of them when that is under a tenth)',
+            'noise_floor_percent': data.floor_holdout_percent,
+            'baseline_er_percent': data.judged_er_percent(baseline),
+            'final_er_percent': data.judged_er_percent(final)}
 
 
 def _chain_dict(channel: str, p: np.ndarray) -> dict:
@@ -285,13 +314,19 @@ def _try(m: Mechanism, current: FitResult, data: Data, ctx: Context,
     if getattr(m, 'swap_family', ''):
         fit = _swap_family(m, current, data, ctx, settings, thetas)
     else:
-        model = ComposedModel(ctx.channel, list(prev.mechanisms) + [m], ctx,
-                              prev.bounds[:prev.n_chain], family=prev.spec.family.id,
-                              swapped_by=prev.swapped_by)
-        p_prev = model.pack(current.p[:prev.n_chain], thetas)
-        # the data-built starts are the baseline family's chains
-        fit = fit_model(model, data, p_prev, m, budget=settings.fit_budget,
-                        chain_starts=[c for c in chain_starts if c.size == prev.n_chain])
+        # the first filter on a static chain is fitted in both hold conventions
+        holds = (prev.hold,) if prev.dynamic or m.stage != 'sensor' else HOLDS
+        fit = None
+        for hold in holds:
+            model = ComposedModel(ctx.channel, list(prev.mechanisms) + [m], ctx,
+                                  prev.bounds[:prev.n_chain], family=prev.spec.family.id,
+                                  swapped_by=prev.swapped_by, hold=hold)
+            p_prev = model.pack(current.p[:prev.n_chain], thetas)
+            # the data-built starts are the baseline family's chains
+            got = fit_model(model, data, p_prev, m, budget=settings.fit_budget,
+                            chain_starts=[c for c in chain_starts if c.size == prev.n_chain])
+            if fit is None or got.sse_train < fit.sse_train:
+                fit = got
     comp = compare(current, fit, data, m.id, settings.criteria)
     comp.evidence, comp.where = m.evidence(loc)
     model = fit.model
@@ -314,7 +349,8 @@ def _swap_family(m: Mechanism, current: FitResult, data: Data, ctx: Context,
     rec_train = Recording(data.t_s[:n], data.v[:n], data.y[:n], ctx.channel)
     spec = domains_from_data(rec_train, family=fam)
     keep = [pm for pm in prev.mechanisms if pm.families is None or fam in pm.families]
-    model = ComposedModel(ctx.channel, keep, ctx, spec.bounds, family=fam, swapped_by=m.id)
+    model = ComposedModel(ctx.channel, keep, ctx, spec.bounds, family=fam, swapped_by=m.id,
+                          hold=prev.hold)
     x_ga, starts = baseline_starts(rec_train, spec, settings)
     best = None
     for x0 in [x_ga] + starts:

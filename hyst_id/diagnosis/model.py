@@ -24,6 +24,14 @@ b``, the static nonlinearity's polynomial terms, the drift rate, the
 supply-decay offset) is a column of a regressor matrix and is profiled by
 linear least squares on the training samples only; the same coefficients
 then predict the held-out samples (variable projection).
+
+Every dynamic element after the static loop (the channel's sensor, the
+``sensor``-stage blocks) is a zero-order-hold filter, in one of the two
+conventions of :data:`hyst_id.identification.chains.HOLDS` (the model's
+``hold``): ``before`` takes sample ``j``'s input as held over
+``(t(j-1), t(j)]``, ``after`` holds ``x(j-1)`` over ``[t(j-1), t(j))``,
+one sample later, as other simulators and sampled rigs do. The diagnosis
+lets the data choose (:func:`held`).
 """
 
 from __future__ import annotations
@@ -33,10 +41,24 @@ from typing import Sequence
 import numpy as np
 
 from hyst_id.diagnosis.mechanisms.base import Context, Mechanism, STAGES
-from hyst_id.identification.chains import chain_spec
+from hyst_id.errors import ConfigError
+from hyst_id.identification.chains import chain_spec, HOLDS
 from hyst_id.models.sensors import simulate_first_order, simulate_second_order
 
-__all__ = ['ComposedModel', 'Evaluation', 'solve_linear']
+__all__ = ['ComposedModel', 'Evaluation', 'held', 'solve_linear']
+
+
+def held(x: np.ndarray, hold: str) -> np.ndarray:
+    """A filter's input in the package's convention for the ``hold`` convention.
+
+    The package's filters (:mod:`hyst_id.models.sensors`) hold sample ``j``
+    over ``(t(j-1), t(j)]``; with ``hold='after'`` it is ``x(j-1)`` that is
+    held there, so the input is moved one sample later (the first kept).
+    """
+    x = np.asarray(x, dtype=float)
+    if hold == 'before' or x.size < 2:
+        return x
+    return np.concatenate([x[:1], x[:-1]])
 
 
 class Evaluation:
@@ -74,12 +96,17 @@ class ComposedModel:
         H's family (default the paper's ``tk``).
     swapped_by : str, optional
         Id of the mechanism that swapped H's family in (listed first in :attr:`ids`).
+    hold : {'before', 'after'}, optional
+        Zero-order-hold convention of every dynamic element (see the module docstring).
     """
 
     def __init__(self, channel: str, mechanisms: Sequence[Mechanism], ctx: Context,
                  chain_bounds: np.ndarray, family: str | None = None,
-                 swapped_by: str = '') -> None:
+                 swapped_by: str = '', hold: str = 'before') -> None:
+        if hold not in HOLDS:
+            raise ConfigError(f'hold must be one of {HOLDS}, got {hold!r}')
         self.channel = channel
+        self.hold = hold
         self.swapped_by = swapped_by
         self.ctx = ctx
         self.mechanisms = tuple(sorted(mechanisms, key=lambda m: STAGES.index(m.stage)))
@@ -102,6 +129,11 @@ class ComposedModel:
         """Mechanism ids in signal order (a family swap first)."""
         return ((self.swapped_by,) if self.swapped_by else ()) + tuple(
             m.id for m in self.mechanisms)
+
+    @property
+    def dynamic(self) -> bool:
+        """Whether any element is a filter, i.e. whether :attr:`hold` matters."""
+        return self.channel != 'position' or any(m.stage == 'sensor' for m in self.mechanisms)
 
     @property
     def n_linear(self) -> int:
@@ -171,7 +203,7 @@ class ComposedModel:
         basis = [self._sensor(x_chain, t_s, b) for b in basis]
         for m in self.mechanisms:
             if m.stage == 'sensor':
-                basis = [m.sensor(th[m.id], t_s, b) for b in basis]
+                basis = [m.sensor(th[m.id], t_s, held(b, self.hold)) for b in basis]
         labels = ['sensor'] + [f'quantity:{i}' for i in range(1, len(basis))] + ['offset']
         columns = basis + [np.ones_like(t_s)]
         for m in self.mechanisms:
@@ -184,6 +216,8 @@ class ComposedModel:
 
     def _sensor(self, x_chain: np.ndarray, t_s: np.ndarray, s: np.ndarray) -> np.ndarray:
         sensor = x_chain[self.spec.sensor_slice]
+        if self.channel != 'position':
+            s = held(s, self.hold)
         if self.channel == 'pressure':
             return simulate_first_order(s, t_s, float(sensor[0]))
         if self.channel == 'flow':

@@ -96,6 +96,13 @@ def format_diagnosis(d: Any) -> str:
         lines.append(f'final model: baseline + {" + ".join(fin.ids)}: %e_r train '
                      f'{_fmt(fin.er_train_percent)}, held-out {_fmt(fin.er_holdout_percent)} '
                      f'= {ratio:.2f} x the noise floor')
+        j = d.extra.get('judged_holdout')
+        if j and j['n_samples'] < j['n_holdout']:
+            lines.append(f'judged on the first {j["n_samples"]} of {j["n_holdout"]} held-out '
+                         'samples (before the command leaves the training range): %e_r '
+                         f'{_fmt(j["baseline_er_percent"])} -> {_fmt(j["final_er_percent"])} '
+                         f'= {j["final_er_percent"] / j["noise_floor_percent"]:.2f} x the '
+                         'noise floor there')
         fl = d.final_localization
         lines.append('remaining residual: ' + ('white and independent of the command'
                                                if not fl.structured else

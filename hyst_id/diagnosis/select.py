@@ -84,13 +84,29 @@ class Data:
     y: np.ndarray
     n_train: int
     noise_std: float = 0.0
+    #: held-out rows blocks are judged on (default all; see
+    #: :func:`hyst_id.signals.split.inside_rows`)
+    judged: np.ndarray | None = None
+
+    @property
+    def judged_rows(self) -> np.ndarray:
+        """Absolute indices of the held-out samples the criteria look at."""
+        if self.judged is None:
+            return np.arange(self.n_train, self.y.size)
+        return np.asarray(self.judged, dtype=int)
 
     @property
     def floor_holdout_percent(self) -> float:
-        """%e_r that the noise alone gives on the held-out part."""
-        ho = self.y[self.n_train:]
+        """%e_r that the noise alone gives on the judged held-out samples."""
+        ho = self.y[self.judged_rows]
         return float(np.sqrt(ho.size * self.noise_std ** 2 / max(float(ho @ ho), 1e-300))
                      * 100.0)
+
+    def judged_er_percent(self, fit: FitResult) -> float:
+        """%e_r of a fit on the judged held-out samples."""
+        rows = self.judged_rows
+        r = fit.residual[rows]
+        return float(er_percent(float(r @ r), self.y[rows])) if rows.size else float('nan')
 
     @property
     def n_holdout(self) -> int:
@@ -342,13 +358,12 @@ def compare(current: FitResult, candidate: FitResult, data: Data, mechanism: str
     """Decide whether candidate (current + one block) is supported by the data."""
     n = data.n_train
     d_bic = candidate.bic(n) - current.bic(n)
-    nt = data.n_train
-    z = improvement_z(current.prediction[nt:], candidate.prediction[nt:], data.y[nt:],
+    rows = data.judged_rows
+    z = improvement_z(current.prediction[rows], candidate.prediction[rows], data.y[rows],
                       data.noise_std)
-    gain = (1.0 - candidate.er_holdout_percent / current.er_holdout_percent
-            if current.er_holdout_percent > 0 else 0.0)
-    share = explained_share(current.er_holdout_percent, candidate.er_holdout_percent,
-                            data.floor_holdout_percent)
+    er_cur, er_cand = data.judged_er_percent(current), data.judged_er_percent(candidate)
+    gain = 1.0 - er_cand / er_cur if er_cur > 0 else 0.0
+    share = explained_share(er_cur, er_cand, data.floor_holdout_percent)
     ok_train = d_bic < -criteria.bic_drop
     ok_hold = z > criteria.z_min and gain >= criteria.min_gain and share >= criteria.min_share
     status = 'accepted' if ok_train and ok_hold else (
@@ -368,12 +383,13 @@ def choose(comparisons: list[Comparison], data: Data, criteria: Criteria
     ok = [c for c in comparisons if c.accepted]
     if not ok:
         return None, []
-    best = min(ok, key=lambda c: c.fit.sse_holdout)
-    nt = data.n_train
-    near = max(criteria.tie_ratio * best.fit.er_holdout_percent,
+    er = {id(c): data.judged_er_percent(c.fit) for c in ok}
+    best = min(ok, key=lambda c: er[id(c)])
+    rows = data.judged_rows
+    near = max(criteria.tie_ratio * er[id(best)],
                criteria.tie_floor * data.floor_holdout_percent)
-    tied = [c for c in ok if c is best or c.fit.er_holdout_percent <= near
-            or improvement_z(c.fit.prediction[nt:], best.fit.prediction[nt:], data.y[nt:],
+    tied = [c for c in ok if c is best or er[id(c)] <= near
+            or improvement_z(c.fit.prediction[rows], best.fit.prediction[rows], data.y[rows],
                              data.noise_std) < criteria.tie_z]
     n = data.n_train
     bics = {c.mechanism: c.fit.bic(n) for c in tied}
@@ -383,12 +399,15 @@ def choose(comparisons: list[Comparison], data: Data, criteria: Criteria
     return winner, [c for c in tied if c is not winner]
 
 
-def round_record(round_no: int, comps: list[Comparison], winner: Comparison | None) -> dict:
+def round_record(round_no: int, comps: list[Comparison], winner: Comparison | None,
+                 data: Data | None = None) -> dict:
     """JSON record of one selection round: every candidate with its criteria."""
     return {'round': round_no, 'candidates': [
         {'mechanism': c.mechanism, 'status': c.status, 'chosen': c is winner,
          'er_train_percent': c.fit.er_train_percent,
-         'er_holdout_percent': c.fit.er_holdout_percent, 'delta_bic': c.delta_bic,
+         'er_holdout_percent': c.fit.er_holdout_percent,
+         'er_judged_percent': data.judged_er_percent(c.fit) if data is not None
+         else c.fit.er_holdout_percent, 'delta_bic': c.delta_bic,
          'holdout_z': c.holdout_z, 'holdout_gain': c.gain, 'explained_share': c.share,
          'evidence': c.evidence}
         for c in comps]}

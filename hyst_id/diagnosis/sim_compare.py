@@ -63,7 +63,7 @@ from hyst_id.identification.chains import er_percent
 from hyst_id.io.recording import Recording, roundoff_probe, validate_recording
 from hyst_id.signals.noise import floor_percent
 from hyst_id.signals.reversals import reversal_times
-from hyst_id.signals.split import split_index
+from hyst_id.signals.split import inside_rows, split_index
 
 __all__ = ['SIM_EFFECTS', 'diagnose_sim', 'simulate_clean']
 
@@ -305,7 +305,8 @@ def _diagnose_sim(recording, base, settings, say):
     rev = reversal_times(t[:n_train], v[:n_train])
     period = float(2 * np.median(np.diff(rev))) if rev.size > 2 else 0.25 * (t[-1] - t[0])
     sigma = noise_std(y)
-    data = Data(t_s=t, v=v, y=y, n_train=n_train, noise_std=sigma)
+    data = Data(t_s=t, v=v, y=y, n_train=n_train, noise_std=sigma,
+                judged=inside_rows(v, n_train))
     say('simulating the command of the recording with the given simulator parameters')
     pred0 = simulate_clean(base, t, v, ch)
     baseline = _result((), [], pred0, y, n_train)
@@ -341,7 +342,7 @@ def _diagnose_sim(recording, base, settings, say):
             comps.append(comp)
             spaces[mid] = (obj, theta)
         winner, tied = choose(comps, data, settings.criteria)
-        rounds.append(round_record(round_no + 1, comps, winner))
+        rounds.append(round_record(round_no + 1, comps, winner, data))
         if winner is None:
             break
         obj, theta = spaces[winner.mechanism]
@@ -363,7 +364,7 @@ def _diagnose_sim(recording, base, settings, say):
                      noise_floor_train_percent=floor_percent(y[:n_train], sigma),
                      rounds=rounds, measurement_unit=rec.measurement_unit,
                      command_unit=rec.command_unit,
-                     notes=list(rec.notes) + range_note(v, n_train),
+                     notes=list(rec.notes) + range_note(v, n_train, data.judged_rows.size),
                      extra={'simulator_changes': {k: val for d in applied.values()
                                                   for k, val in d.items()}})
     return diag, params

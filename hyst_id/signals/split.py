@@ -20,7 +20,7 @@ import numpy as np
 
 from hyst_id.errors import ConfigError
 
-__all__ = ['split_index']
+__all__ = ['inside_rows', 'split_index']
 
 
 def split_index(t_s: np.ndarray, train_fraction: float) -> int:
@@ -43,3 +43,41 @@ def split_index(t_s: np.ndarray, train_fraction: float) -> int:
     t = np.asarray(t_s, dtype=np.float64)
     t_cut = t[0] + train_fraction * (t[-1] - t[0])
     return int(np.searchsorted(t, t_cut))
+
+
+def inside_rows(command: np.ndarray, n_train: int, *, tol: float = 0.02,
+                min_share: float = 0.1, min_samples: int = 30) -> np.ndarray:
+    """Held-out rows whose prediction is not an extrapolation: before the command leaves.
+
+    A hysteresis remembers its turning points, so once the held-out command
+    has gone beyond the training range (by more than ``tol`` of it) every
+    later sample depends on a turning point the model never saw fitted. The
+    rows kept are the held-out ones before that first excursion; when they
+    are fewer than ``min_share`` of the held-out part or ``min_samples``,
+    the whole held-out part is returned (nothing better to judge on).
+
+    Parameters
+    ----------
+    command : numpy.ndarray
+        The whole record's command.
+    n_train : int
+        Training samples (the held-out part follows).
+    tol, min_share, min_samples : float, float, int
+        See above.
+
+    Returns
+    -------
+    numpy.ndarray
+        Absolute row indices (int) into the record, a prefix of the held-out part.
+    """
+    v = np.asarray(command, dtype=float)
+    n = v.size
+    if n_train >= n:
+        return np.arange(n_train, n)
+    lo, hi = float(np.min(v[:n_train])), float(np.max(v[:n_train]))
+    margin = tol * (hi - lo)
+    out = np.flatnonzero((v[n_train:] < lo - margin) | (v[n_train:] > hi + margin))
+    stop = n if out.size == 0 else n_train + int(out[0])
+    if stop - n_train < max(min_samples, min_share * (n - n_train)):
+        stop = n
+    return np.arange(n_train, stop)

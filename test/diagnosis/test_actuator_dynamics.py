@@ -51,38 +51,50 @@ def _recording(seed: int, zeta: float | None, omega_n: float = 2.5,
                      'mm', f'actuator dynamics #{seed}')
 
 
-@pytest.mark.parametrize('seed', [0, 1])
-def test_a_ringing_actuator_is_named_with_its_dynamics(seed):
-    """Named, with its damping and frequency; most of the held-out error removed.
+def _judged_ratio(d) -> float:
+    """Final %e_r over the noise floor on the held-out rows the blocks were judged on."""
+    j = d.extra['judged_holdout']
+    return j['final_er_percent'] / j['noise_floor_percent']
 
-    Measured on noise seeds 0-7: named 8/8, zeta 0.304-0.307, omega_n 2.407-2.433 rad/s,
-    held-out error from 11-33 x the floor before the block to 1.3-9.3 x after (after /
-    before 0.06-0.31). Not at the floor: the block is refitted around a baseline biased by
-    the dynamics it lacked (issue 14's "refit to the floor", not built), which also pulls
-    omega_n 3-4 % low. The bounds sit outside that spread.
+
+@pytest.mark.parametrize('seed', [0, 3])
+def test_a_ringing_actuator_is_named_with_its_dynamics(seed):
+    """Named, with its damping and frequency, in the reference's hold convention, at the floor.
+
+    Measured on noise seeds 0-7, unperturbed and under the round-off probes 1-3 (32
+    runs): named 32/32, hold ``after`` every time, zeta 0.2994-0.3003, omega_n
+    2.4971-2.5015 rad/s, training %e_r 0.97-1.04 x its floor, judged held-out 0.96-1.19 x
+    the floor (from 11-34 x before). Seed 3's held-out command leaves the training range
+    after 124 of 720 samples; the whole held-out part there ends at 1.0-16.9 x depending
+    on the probe (extrapolation, reported apart). Before the hold convention was chosen
+    from the data: zeta 0.304-0.307, omega_n 3-4 % low, 1.3-9.3 x the floor left.
     """
     d = diagnose(_recording(seed, 0.3), settings=SETTINGS)
     assert d.verdict == 'actuator_dynamics', [f.mechanism for f in d.findings]
+    assert d.extra['hold'] == 'after'
     f = d.findings[0]
-    assert f.params['zeta'].value == pytest.approx(0.3, rel=0.1)
-    assert f.params['omega_n_rad_s'].value == pytest.approx(2.5, rel=0.1)
+    assert f.params['zeta'].value == pytest.approx(0.3, rel=0.02)
+    assert f.params['omega_n_rad_s'].value == pytest.approx(2.5, rel=0.02)
+    assert _judged_ratio(d) < 1.3
     assert f.er_holdout_after_percent < 0.5 * f.er_holdout_before_percent
 
 
-@pytest.mark.parametrize('seed', [5, 8])
+@pytest.mark.parametrize('seed', [3, 7])
 def test_a_first_order_lag_stays_sensor_lag(seed):
-    """A 0.4 s lag is ``sensor_lag``.
+    """A 0.4 s lag is ``sensor_lag`` with its time constant, where the held-out part extrapolates.
 
-    Measured on noise seeds 3-8, unperturbed and under the round-off probe 1, 2 and 3
-    (``HYST_ID_ROUNDOFF_PROBE``, another CPU's last bits): ``sensor_lag`` in 19 of 24.
-    Seeds 4, 5, 6 and 8 every time (the lag block leaves 1.46-2.19 x the floor); seed 7
-    always and seed 3 once (probe 1) go to ``actuator_dynamics``: there the lag block's fit
-    is stuck at 3.6-7.1 x the floor (no global refit after a block, issue 14) and the
-    two blocks compete. The test takes the two seeds whose lag fit is closest to the
-    floor; seed 3, once taken here, flipped under the probe.
+    Measured on noise seeds 3-8, unperturbed and under the round-off probes 1-3 (24 runs):
+    ``sensor_lag`` 24/24, tau 0.3985-0.4015 s, judged held-out 0.96-1.56 x the floor. Seeds
+    3 and 7 are the ones whose held-out command leaves the training range (after 124 and 249
+    of 720 samples): before the blocks were judged on the rows before that, they went to
+    ``dead_time`` or ``actuator_dynamics`` (the lag fitted the training part at the floor
+    and lost 17-22 x on the extrapolated rest); judged there they end at 0.96-1.01 x.
     """
     d = diagnose(_recording(seed, None, lag_s=0.4), settings=SETTINGS)
     assert d.verdict == 'sensor_lag', [f.mechanism for f in d.findings]
+    assert d.findings[0].params['tau_lag_s'].value == pytest.approx(0.4, rel=0.03)
+    assert d.extra['judged_holdout']['n_samples'] < d.extra['judged_holdout']['n_holdout']
+    assert _judged_ratio(d) < 1.3
 
 
 def test_actuator_dynamics_is_registered_with_words():
