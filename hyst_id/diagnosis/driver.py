@@ -50,7 +50,7 @@ from hyst_id.diagnosis.empirical import empirical_block
 from hyst_id.diagnosis.locate import Localization, locate, noise_std
 from hyst_id.diagnosis.mechanisms import get_mechanisms
 from hyst_id.diagnosis.mechanisms.base import Context, Mechanism
-from hyst_id.diagnosis.model import ComposedModel
+from hyst_id.diagnosis.model import ComposedModel, held
 from hyst_id.diagnosis.result import DiagnoseSettings, Diagnosis, Finding
 from hyst_id.diagnosis.select import (
     choose,
@@ -325,6 +325,8 @@ def _try(m: Mechanism, current: FitResult, data: Data, ctx: Context,
             # the data-built starts are the baseline family's chains
             got = fit_model(model, data, p_prev, m, budget=settings.fit_budget,
                             chain_starts=[c for c in chain_starts if c.size == prev.n_chain])
+            if len(holds) > 1 and hold == 'after' and not _filter_beats_shift(got, m, data):
+                continue        # a one-sample delay in disguise: dead_time's business
             if fit is None or got.sse_train < fit.sse_train:
                 fit = got
     comp = compare(current, fit, data, m.id, settings.criteria)
@@ -335,6 +337,19 @@ def _try(m: Mechanism, current: FitResult, data: Data, ctx: Context,
     if reason and comp.accepted:
         comp.accepted, comp.status = False, f'rejected: {reason}'
     return comp
+
+
+def _filter_beats_shift(fit: FitResult, m: Mechanism, data: Data) -> bool:
+    """Whether a filter block fitted in the ``after`` convention does more than its hold.
+
+    On a static chain the ``after`` convention is itself a one-sample delay, so a
+    nearly transparent filter in it is a delay (``dead_time``), not dynamics: the
+    block must change its (held) input by more than the hold's shift does.
+    """
+    x = fit.travel_raw[:data.n_train]
+    shifted = held(x, 'after')
+    out = m.sensor(fit.model.theta(fit.p, m.id), data.t_s[:data.n_train], shifted)
+    return float(np.linalg.norm(out - shifted)) > float(np.linalg.norm(shifted - x))
 
 
 def _swap_family(m: Mechanism, current: FitResult, data: Data, ctx: Context,
