@@ -1,0 +1,229 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""Blind diagnosis on a random family from the independent reference simulator (issue 14, 5).
+
+Each recording (2,000 samples) is the paper's chain drawn as in
+``bench/generalisation.py`` (random loop, backlash, excitation, rate, noise,
+units) from ``test/reference_sim``, with 0, 1 or 2 effects written here in
+plain numpy at their physical places, at magnitudes drawn log-uniformly from
+barely visible to strong:
+
+* on the command: ``dead_time`` (1-10 samples);
+* on the travel: ``saturation`` (an end stop cutting 2-25 % of the travel's top),
+  ``static_nonlinearity`` (a quadratic term, 1-20 % of the span),
+  ``actuator_dynamics`` (zeta 0.1-0.5, omega_n dt 0.05-0.5);
+* after the channel's sensor: ``sensor_lag`` (tau 0.5-20 samples), ``creep``
+  (a 2-20 % share relaxing with tau 2-20 % of the record), ``gain_drift`` (0.5-15 %
+  over the record), ``offset_drift`` (0.2-10 % of the span over the record).
+
+Every recording is diagnosed blind with the default settings; the effect's cost
+is the baseline's held-out %e_r over the noise floor, both on the judged rows
+(``extra.judged_holdout``). Prints per recording and the issue's figures:
+named right where the effect costs more than 3 x the floor, claims on clean
+recordings, the median final held-out over the floor, seconds per recording;
+writes ``docs/diagnosis_blind.md`` and ``docs/diagnosis_blind.json``.
+
+Run from the repository root (about 30 minutes for 150 recordings on 2 cores)::
+
+    python bench/blind_family.py [--n 150] [--workers 2] [--no-write]
+"""
+
+from __future__ import annotations
+
+import argparse
+from concurrent.futures import ProcessPoolExecutor
+import json
+from pathlib import Path
+import sys
+import time
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / 'test'))
+sys.path.insert(0, str(ROOT / 'bench'))
+sys.path.insert(0, str(ROOT))
+
+from excitations import moves_and_holds  # noqa: E402, I100
+from generalisation import _draw_params, _excitation, EXCITATIONS  # noqa: E402, I100
+from reference_sim import first_order_sensor, second_order_sensor  # noqa: E402, I100
+from reference_sim import simulate as reference_simulate  # noqa: E402, I100
+
+N_SAMPLES = 2000
+EFFECTS = ('dead_time', 'saturation', 'static_nonlinearity', 'actuator_dynamics',
+           'sensor_lag', 'creep', 'gain_drift', 'offset_drift')
+
+
+def _logu(rng: np.random.Generator, lo: float, hi: float) -> float:
+    return float(np.exp(rng.uniform(np.log(lo), np.log(hi))))
+
+
+def draw(index: int) -> dict:
+    """Recording ``index``: command, measurement, the effects and their magnitudes."""
+    rng = np.random.default_rng([index, 14])
+    channel = ('position', 'pressure')[index % 2]
+    n_eff = int(rng.choice([0, 1, 2], p=[0.25, 0.5, 0.25]))
+    effects = sorted(rng.choice(EFFECTS, size=n_eff, replace=False).tolist())
+    dt = float(rng.choice([0.01, 0.02, 0.05, 0.1]))
+    t = np.arange(N_SAMPLES) * dt
+    kind = (*EXCITATIONS, 'moves and holds')[int(rng.integers(0, len(EXCITATIONS) + 1))]
+    if kind == 'moves and holds':
+        v = moves_and_holds(rng, t, dwell_s=t[-1] / 25, move_s=t[-1] / 200, n_levels=25,
+                            lo=6.5, hi=11.5)
+    else:
+        v = _excitation(kind, t, rng)
+    p = _draw_params(channel, v, rng, t[-1])
+    mags: dict[str, float] = {}
+    vv = v
+    if 'dead_time' in effects:
+        d = int(round(_logu(rng, 1.0, 10.0)))
+        mags['dead_time'] = d * dt
+        vv = np.concatenate([np.full(d, v[0]), v[:-d]])
+    x = reference_simulate('position', p, t, vv)
+    span = float(np.ptp(x))
+    if 'saturation' in effects:
+        cut = _logu(rng, 0.02, 0.25)
+        mags['saturation'] = cut
+        x = np.minimum(x, float(np.max(x)) - cut * span)
+    if 'static_nonlinearity' in effects:
+        c = _logu(rng, 0.01, 0.2)
+        mags['static_nonlinearity'] = c
+        z = (x - float(np.min(x))) / span
+        x = x + c * span * z ** 2
+    if 'actuator_dynamics' in effects:
+        zeta, wdt = rng.uniform(0.1, 0.5), _logu(rng, 0.05, 0.5)
+        mags['actuator_dynamics'] = wdt
+        x = second_order_sensor(t, x, zeta, wdt / dt)
+    y = first_order_sensor(t, x, p['tau_s']) if channel == 'pressure' else x
+    span = float(np.ptp(y))
+    if 'sensor_lag' in effects:
+        tau = _logu(rng, 0.5, 20.0) * dt
+        mags['sensor_lag'] = tau
+        y = first_order_sensor(t, y, tau)
+    if 'creep' in effects:
+        share, tau_c = _logu(rng, 0.02, 0.2), rng.uniform(0.02, 0.2) * t[-1]
+        mags['creep'] = share
+        y = (1.0 - share) * y + share * first_order_sensor(t, y, tau_c)
+    mean = float(np.mean(y))
+    if 'gain_drift' in effects:
+        g = _logu(rng, 0.005, 0.15)
+        mags['gain_drift'] = g
+        y = mean + (y - mean) * (1.0 + g * t / t[-1])
+    if 'offset_drift' in effects:
+        r = _logu(rng, 0.002, 0.1)
+        mags['offset_drift'] = r
+        y = y + r * span * t / t[-1]
+    sigma = rng.uniform(0.002, 0.01) * span
+    y = y + rng.normal(0.0, sigma, y.size)
+    a, b = float(np.exp(rng.uniform(np.log(0.5), np.log(5.0)))), float(rng.uniform(-5, 5))
+    k = float(np.exp(rng.uniform(np.log(0.1), np.log(100.0))))
+    return {'index': index, 'channel': channel, 'excitation': kind, 'dt_s': dt,
+            'effects': effects, 'magnitudes': mags, 't': t, 'command': a * v + b,
+            'measurement': k * y + rng.uniform(-10, 10) * k,
+            'noise_percent_of_span': 100.0 * sigma / span}
+
+
+def run(index: int) -> dict:
+    """Draw and diagnose one recording; what the tables need."""
+    from hyst_id.diagnosis import diagnose, DiagnoseSettings
+    from hyst_id.io.recording import Recording
+    case = draw(index)
+    rec = Recording(case['t'], case['command'], case['measurement'], case['channel'],
+                    source=f'blind #{index}')
+    t0 = time.time()
+    d = diagnose(rec, settings=DiagnoseSettings(workers=1))
+    j = d.extra['judged_holdout']
+    out = {k: case[k] for k in ('index', 'channel', 'excitation', 'dt_s', 'effects',
+                                'magnitudes', 'noise_percent_of_span')}
+    out.update(verdict=d.verdict, found=[f.mechanism for f in d.findings],
+               cost=j['baseline_er_percent'] / j['noise_floor_percent'],
+               final=j['final_er_percent'] / j['noise_floor_percent'],
+               seconds=time.time() - t0)
+    return out
+
+
+def _right(r: dict) -> bool:
+    return sorted(r['found']) == r['effects'] if r['effects'] else r['verdict'] == 'none'
+
+
+def summary(rows: list[dict]) -> str:
+    """The issue's figures and the confusion of effects against findings, as markdown."""
+    clean = [r for r in rows if not r['effects']]
+    eff = [r for r in rows if r['effects']]
+    big = [r for r in eff if r['cost'] > 3.0]
+    first = [r for r in big if r['found'] and r['found'][0] in r['effects']]
+    claims = [r for r in clean if r['found']]
+    lines = ['| figure | value | target |', '|---|---|---|',
+             f'| recordings | {len(rows)} ({len(clean)} clean, '
+             f'{sum(len(r["effects"]) == 1 for r in rows)} with one effect, '
+             f'{sum(len(r["effects"]) == 2 for r in rows)} with two) | >= 150 |',
+             f'| every effect named, nothing else, where the effects cost > 3 x the floor | '
+             f'{sum(map(_right, big))}/{len(big)} | >= 90 % |',
+             f'| first finding is one of the effects (same recordings) | '
+             f'{len(first)}/{len(big)} | |',
+             f'| physical claims on clean recordings | {len(claims)}/{len(clean)} '
+             f'({", ".join(sorted({r["verdict"] for r in claims})) or "-"}) | 0 |',
+             '| median final held-out / floor (judged rows), recordings with effects | '
+             f'{np.median([r["final"] for r in eff]):.2f} | <= 1.2 |',
+             f'| seconds per recording, median / max (2,000 samples, one worker each) | '
+             f'{np.median([r["seconds"] for r in rows]):.0f} / '
+             f'{max(r["seconds"] for r in rows):.0f} | <= 60 |', '']
+    lines += ['Per effect (recordings that contain it; named = among the findings):', '',
+              '| effect | recordings | cost > 3 x | named there | named at cost <= 3 x |',
+              '|---|---|---|---|---|']
+    for e in EFFECTS:
+        has = [r for r in eff if e in r['effects']]
+        hi = [r for r in has if r['cost'] > 3.0]
+        lo = [r for r in has if r['cost'] <= 3.0]
+        lines.append(f'| {e} | {len(has)} | {len(hi)} | {sum(e in r["found"] for r in hi)} | '
+                     f'{sum(e in r["found"] for r in lo)}/{len(lo)} |')
+    wrong = [r for r in big if not _right(r)]
+    lines += ['', 'Misses where the effects cost > 3 x the floor:', '']
+    lines += [f'- #{r["index"]} {r["channel"]}, {r["excitation"]}, {1 / r["dt_s"]:g} Hz: '
+              f'{"+".join(r["effects"])} ({r["cost"]:.1f} x) -> '
+              f'{"+".join(r["found"]) or r["verdict"]} (final {r["final"]:.2f} x)'
+              for r in wrong] or ['- none']
+    return '\n'.join(lines)
+
+
+def main() -> int:
+    """Run the family, print and write the tables."""
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument('--n', type=int, default=150)
+    ap.add_argument('--workers', type=int, default=2)
+    ap.add_argument('--no-write', action='store_true')
+    args = ap.parse_args()
+    rows, t0 = [], time.time()
+    with ProcessPoolExecutor(args.workers) as pool:
+        for r in pool.map(run, range(args.n)):
+            rows.append(r)
+            print(f'[{len(rows)}/{args.n} {time.time() - t0:.0f} s] #{r["index"]} '
+                  f'{r["channel"]} {r["excitation"]} {1 / r["dt_s"]:g} Hz '
+                  f'{"+".join(r["effects"]) or "clean"} (cost {r["cost"]:.1f} x) -> '
+                  f'{"+".join(r["found"]) or r["verdict"]} (final {r["final"]:.2f} x, '
+                  f'{r["seconds"]:.0f} s)', flush=True)
+    text = summary(rows)
+    print(text)
+    if not args.no_write:
+        (ROOT / 'docs' / 'diagnosis_blind.json').write_text(json.dumps(rows, indent=1))
+        (ROOT / 'docs' / 'diagnosis_blind.md').write_text(
+            '# Blind diagnosis on the reference family (issue 14)\n\nWritten by '
+            f'`python bench/blind_family.py --n {args.n}`; see the docstring of the script '
+            'for the family.\n\n' + text + '\n')
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())
