@@ -116,11 +116,10 @@ def draw(index: int) -> dict:
         share, tau_c = _logu(rng, 0.02, 0.2), rng.uniform(0.02, 0.2) * t[-1]
         mags['creep'] = share
         y = (1.0 - share) * y + share * first_order_sensor(t, y, tau_c)
-    mean = float(np.mean(y))
-    if 'gain_drift' in effects:
+    if 'gain_drift' in effects:       # the sensitivity, about the sensor's zero
         g = _logu(rng, 0.005, 0.15)
         mags['gain_drift'] = g
-        y = mean + (y - mean) * (1.0 + g * t / t[-1])
+        y = y * (1.0 + g * t / t[-1])
     if 'offset_drift' in effects:
         r = _logu(rng, 0.002, 0.1)
         mags['offset_drift'] = r
