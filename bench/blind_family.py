@@ -38,6 +38,7 @@ writes ``docs/diagnosis_blind.md`` and ``docs/diagnosis_blind.json``.
 Run from the repository root (about 30 minutes for 150 recordings on 2 cores)::
 
     python bench/blind_family.py [--n 150] [--workers 2] [--no-write]
+    python bench/blind_family.py --from-json     # the tables again, from the last run
 """
 
 from __future__ import annotations
@@ -179,6 +180,19 @@ def summary(rows: list[dict]) -> str:
              f'| seconds per recording, median / max (2,000 samples, one worker each) | '
              f'{np.median([r["seconds"] for r in rows]):.0f} / '
              f'{max(r["seconds"] for r in rows):.0f} | <= 60 |', '']
+    one = [r for r in big if len(r['effects']) == 1]
+    two = [r for r in big if len(r['effects']) == 2]
+    right_one = sum(r['verdict'] == r['effects'][0] for r in one)
+    lines += [f'Above 3 x: one effect, verdict right {right_one}'
+              f'/{len(one)}, all findings right {sum(map(_right, one))}/{len(one)}; two effects, '
+              f'both named {sum(map(_right, two))}/{len(two)}, at least one '
+              f'{sum(any(f in r["effects"] for f in r["found"]) for r in two)}/{len(two)}. '
+              f'Clean baselines above 1.5 x the floor: '
+              f'{sum(r["cost"] > 1.5 for r in clean)}/{len(clean)}; clean claims where the '
+              f'baseline stopped above 1.4 x: '
+              f'{sum(r["cost"] > 1.4 for r in claims)}/{len(claims)} '
+              f'(position {sum(r["channel"] == "position" for r in claims)}, pressure '
+              f'{sum(r["channel"] == "pressure" for r in claims)}).', '']
     lines += ['Per effect (recordings that contain it; named = among the findings):', '',
               '| effect | recordings | cost > 3 x | named there | named at cost <= 3 x |',
               '|---|---|---|---|---|']
@@ -203,7 +217,12 @@ def main() -> int:
     ap.add_argument('--n', type=int, default=150)
     ap.add_argument('--workers', type=int, default=2)
     ap.add_argument('--no-write', action='store_true')
+    ap.add_argument('--from-json', action='store_true',
+                    help='only reprint the tables from docs/diagnosis_blind.json')
     args = ap.parse_args()
+    if args.from_json:
+        print(summary(json.loads((ROOT / 'docs' / 'diagnosis_blind.json').read_text())))
+        return 0
     rows, t0 = [], time.time()
     with ProcessPoolExecutor(args.workers) as pool:
         for r in pool.map(run, range(args.n)):
