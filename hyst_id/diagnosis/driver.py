@@ -344,7 +344,9 @@ def _filter_beats_shift(fit: FitResult, m: Mechanism, data: Data) -> bool:
 
     On a static chain the ``after`` convention is itself a one-sample delay, so a
     nearly transparent filter in it is a delay (``dead_time``), not dynamics: the
-    block must change its (held) input by more than the hold's shift does.
+    block must change its (held) input by more than the hold's shift does. The
+    input is taken as the chain's travel (before position-stage blocks such as
+    an end stop, which change it little): a screening test, not the fit.
     """
     x = fit.travel_raw[:data.n_train]
     shifted = held(x, 'after')
