@@ -46,6 +46,7 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from hyst_id.diagnosis.baseline import baseline_starts
+from hyst_id.diagnosis.control import null_control, recheck
 from hyst_id.diagnosis.empirical import empirical_block
 from hyst_id.diagnosis.locate import Localization, locate, noise_std
 from hyst_id.diagnosis.mechanisms import get_mechanisms
@@ -201,14 +202,14 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
     data = Data(t_s=t, v=v, y=y, n_train=n_train, noise_std=sigma,
                 judged=inside_rows(v, n_train))
     say(f'baseline: GAASS x {len(settings.seeds)} seeds on the first {n_train} samples')
-    x_ga, starts = baseline_starts(rec_train, spec, settings)
+    x_fits, starts = baseline_starts(rec_train, spec, settings)
     # a channel with a sensor has dynamics from the start: its hold convention is chosen
     # here, on the training error (a position chain is static until a filter block joins)
     holds = HOLDS if rec.channel != 'position' else HOLDS[:1]
     polished = sorted((polish(model, data, x0, max_nfev=2 * settings.fit_budget) + (x0, model)
                        for model in [ComposedModel(rec.channel, [], ctx, spec.bounds, hold=h)
                                      for h in holds]
-                       for x0 in [x_ga] + starts), key=lambda z: z[1])
+                       for x0 in x_fits + starts), key=lambda z: z[1])
     baseline = evaluate(polished[0][4], data, polished[0][0], polished[0][2])
     # the neutral data-built starts whose basins fitted best seed the mechanism fits
     chain_starts = [z[3] for z in polished if any(z[3] is s for s in starts)
@@ -234,6 +235,13 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
             say(f'round {round_no + 1}: testing {m.id}')
             comps.append(_try(m, current, data, ctx, settings, loc, chain_starts))
         winner, tied = choose(comps, data, settings.criteria)
+        null = None if winner is None else null_control(
+            winner, current, data, max_nfev=2 * settings.fit_budget)
+        if null is not None and recheck(comps, null, data, settings.criteria):
+            say(f"round {round_no + 1}: {winner.mechanism} was the chain refit's doing")
+            current = null
+            loc = locate(t, v_orig, y, current.prediction, sigma, n_train, ctx.period_s)
+            winner, tied = choose(comps, data, settings.criteria)
         rounds.append(round_record(round_no + 1, comps, winner, data))
         if winner is None:
             break
@@ -368,9 +376,9 @@ def _swap_family(m: Mechanism, current: FitResult, data: Data, ctx: Context,
     keep = [pm for pm in prev.mechanisms if pm.families is None or fam in pm.families]
     model = ComposedModel(ctx.channel, keep, ctx, spec.bounds, family=fam, swapped_by=m.id,
                           hold=prev.hold)
-    x_ga, starts = baseline_starts(rec_train, spec, settings)
+    x_fits, starts = baseline_starts(rec_train, spec, settings, thorough=False)
     best = None
-    for x0 in [x_ga] + starts:
+    for x0 in x_fits + starts:
         p0 = model.pack(x0, thetas)
         if not model.feasible(p0):
             continue

@@ -17,10 +17,13 @@
 The bags in ``bags/`` were made by ``bench/make_concealed_bags.py`` with the
 rig simulator, one effect switched on or none; their names do not reveal it.
 Each is read and diagnosed without any hint, then checked against the answer
-key kept in that script: the named mechanism, a held-out %e_r that falls by
-at least 30 % and ends within 1.5 x the noise floor, and ``none`` for the
-clean ones. Also the ``--sim`` mode on one bag: the simulator with the
-found effect switched on matches the recording.
+key kept in that script: the named mechanism, a block that explains at least
+30 % of the baseline's held-out mismatch beyond the noise floor
+(``explained_share``: a baseline close to the floor cannot lose 30 % of its
+%e_r, a strong one absorbs part of a curved characteristic) with a held-out
+%e_r that ends within 1.5 x the noise floor, and ``none`` for the clean
+ones. Also the ``--sim`` mode on one bag: the simulator with the found
+effect switched on matches the recording.
 """
 
 from __future__ import annotations
@@ -31,6 +34,7 @@ from pathlib import Path
 import pytest
 
 from hyst_id.diagnosis import diagnose, DiagnoseSettings
+from hyst_id.diagnosis.select import explained_share
 from hyst_id.io.readers import read_recording
 
 __all__: list[str] = []
@@ -62,7 +66,7 @@ def test_concealed_bag_is_diagnosed_blind(name):
     if expected == 'none':
         assert d.findings == []
         return
-    assert after <= 0.7 * before, d.report()
+    assert explained_share(before, after, d.noise_floor_percent) >= 0.3, d.report()
     if expected == 'stiction':
         check_stick_slip_bag(d, values)
         return
