@@ -1,0 +1,72 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""The null control: a block that only carried a chain refit is not claimed.
+
+On a clean recording from the reference simulator, a baseline stopped short
+of its optimum makes any block look like physics (the block's fit polishes
+the chain too); refitted without the block from the block's own chain, the
+baseline does as well, and :func:`recheck` withdraws the acceptance. With a
+real offset drift in the data the block survives the control.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from reference_sim import simulate as reference_simulate
+
+from hyst_id.diagnosis.control import null_control, recheck
+from hyst_id.diagnosis.mechanisms import Context, MECHANISMS
+from hyst_id.diagnosis.model import ComposedModel
+from hyst_id.diagnosis.select import compare, Criteria, Data, evaluate, fit_model
+from hyst_id.identification.chains import chain_spec
+from hyst_id.signals.excitation import multisine
+
+NAMES = ('m_l', 'm_r', 'm_t', 'm_b', 'c_l', 'c_r', 'c_t', 'c_b', 'm_bl', 'c_bl', 'c_br')
+TRUTH = np.array([1.01, 1.05, 0.10, 0.15, -0.25, 0.50, 14.0, 7.0, 1.0, -0.15, 0.15])
+#: an under-converged baseline: the right line and the top line off
+OFF = TRUTH + np.array([0.0, 0.0, 0.02, 0.0, 0.0, 0.15, 0.0, 0.0, 0.0, 0.0, 0.0])
+
+
+def _case(drift: float):
+    t = np.arange(0.0, 120.0, 0.05)
+    v = multisine(t, amplitude_ma=1.8)
+    x = reference_simulate('position', dict(zip(NAMES, TRUTH)), t, v)
+    sigma = 0.004 * np.ptp(x)
+    y = x + drift * np.ptp(x) * t / t[-1] + np.random.default_rng(3).normal(0.0, sigma, t.size)
+    n = int(0.7 * t.size)
+    ctx = Context('position', t, n)
+    data = Data(t_s=t, v=v, y=y, n_train=n, noise_std=sigma)
+    base = ComposedModel('position', [], ctx, chain_spec('position').bounds)
+    m = MECHANISMS['offset_drift']
+    model = ComposedModel('position', [m], ctx, chain_spec('position').bounds)
+    return data, base, m, model
+
+
+@pytest.mark.parametrize('drift, withdrawn', [(0.0, 1), (0.05, 0)])
+def test_a_block_that_only_carried_the_refit_is_withdrawn(drift, withdrawn):
+    data, base, m, model = _case(drift)
+    start = OFF if drift == 0.0 else TRUTH
+    current = evaluate(base, data, start)
+    fit = fit_model(model, data, model.pack(start, {}), m, budget=600)
+    comp = compare(current, fit, data, m.id, Criteria())
+    assert comp.accepted, comp       # against the current baseline it looks like physics
+    null = null_control(comp, current, data, max_nfev=1200)
+    if withdrawn:
+        assert null is not None and null.sse_train < 0.5 * current.sse_train
+        assert null.er_holdout_percent < 1.5 * data.floor_holdout_percent    # 1.11 x here
+    if null is not None:
+        assert recheck([comp], null, data, Criteria()) == withdrawn
+    assert comp.accepted == (not withdrawn), comp.status
