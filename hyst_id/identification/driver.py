@@ -412,12 +412,18 @@ def identify(recording: Recording, *, spec: ChainSpec | None = None,
                        for seed in settings.seeds], n_workers,
             on_result=on_result, should_stop=should_stop)
     best = min(runs, key=lambda r: r.fun)
-    if settings.refine and settings.global_evals > 0 \
-            and best.er_percent > settings.global_factor * floor:
-        extra = global_phase(replace(spec, initial=best.initial, hold=best.hold), rec,
-                             settings, seed=settings.seeds[0])
+    # the global phase under the best run's conventions, then under the runner-up's
+    # (the ranking of conventions is made from data-built starts and can be wrong)
+    phases = [replace(spec, initial=best.initial, hold=best.hold)]
+    phases += [s for s in others if (s.initial, s.hold) != (best.initial, best.hold)][:1]
+    for k, phase_spec in enumerate(phases):
+        if not (settings.refine and settings.global_evals > 0
+                and best.er_percent > settings.global_factor * floor):
+            break
+        extra = global_phase(phase_spec, rec, settings, seed=settings.seeds[0], run_id=-1 - k)
         if extra.fun < best.fun:
             runs.append(extra)
+            best = extra
     ident = summarise(rec, spec, settings, runs)
     warnings, ident.poorly_determined = assess(ident, rec, spec)
     ident.warnings += warnings
@@ -425,8 +431,8 @@ def identify(recording: Recording, *, spec: ChainSpec | None = None,
 
 
 def global_phase(spec: ChainSpec, rec: Recording, settings: IdentifySettings,
-                 seed: int) -> SeedRun:
-    """One long differential-evolution run over the whole box, refined: seed ``-1``.
+                 seed: int, run_id: int = -1) -> SeedRun:
+    """One long differential-evolution run over the whole box, refined: seed ``run_id``.
 
     GAASS contracts its search space around its best chromosomes, so when
     every seed starts in the same wrong basin they all stay there. On the
@@ -447,7 +453,8 @@ def global_phase(spec: ChainSpec, rec: Recording, settings: IdentifySettings,
     with threadpool_limits(limits=1):
         res = differential_evolution(lambda x: cost(np.ascontiguousarray(x.T)), spec.bounds,
                                      maxiter=maxiter, popsize=popsize, tol=0.0, atol=0.0,
-                                     polish=False, rng=np.random.default_rng([seed, 7]),
+                                     polish=False, rng=np.random.default_rng(
+                                         [seed, 7] if run_id == -1 else [seed, 7, -run_id]),
                                      vectorized=True, updating='deferred')
         x_raw, fun = np.asarray(res.x, dtype=float), float(res.fun)
         x_ref, fun_ref, nfev_ref = refine(spec, x_raw, t_s, v, y,
@@ -456,7 +463,7 @@ def global_phase(spec: ChainSpec, rec: Recording, settings: IdentifySettings,
         x_raw, fun = x_ref, fun_ref
     k, b = spec.fit_calibration(x_raw, t_s, v, y)
     x = canonical_gauge(x_raw, (k, b), spec.family) if k != 0 else x_raw
-    return SeedRun(seed=-1, x_raw=x_raw, x=x, sign=output_sign((k, b)) if k != 0 else 1.0,
+    return SeedRun(seed=run_id, x_raw=x_raw, x=x, sign=output_sign((k, b)) if k != 0 else 1.0,
                    fun=fun if k != 0 else np.inf, er_percent=float(er_percent(fun, y)),
                    er_gaass_percent=float('nan'),
                    nfev=(int(res.nit) + 1) * popsize * spec.n_params + int(nfev_ref),
