@@ -31,10 +31,9 @@ paper's ``tk`` by default). Measurements arrive in the sensor's own units
 sensor dynamics. By default ``k`` and ``b`` are *profiled out*: for every
 candidate the best ``(k, b)`` is the closed-form linear least-squares fit, so
 the optimiser searches only the physical parameters and the calibration is
-always exact for the candidate (variable projection). A fixed calibration
-can be given instead (the paper's position chain is ``k = 1, b = 0``).
-Results are reported in the canonical gauge (:mod:`hyst_id.identification.gauge`),
-where the calibration is ``(1, 0)``.
+always exact for the candidate (variable projection). A fixed one can be
+given (the paper's position chain: ``k = 1, b = 0``). Results are in the
+canonical gauge (:mod:`hyst_id.identification.gauge`): calibration ``(1, 0)``.
 
 The population cost (:meth:`ChainSpec.cost_function`) runs in two numba
 passes per block of candidates: the family's kernel writes H's output, then
@@ -56,20 +55,8 @@ from hyst_id.models.family import HysteresisFamily
 from hyst_id.models.registry import DEFAULT_FAMILY, get_family
 from hyst_id.models.sensors import first_order_coefficient, second_order_coefficients
 
-__all__ = [
-    'CHAIN_NAMES',
-    'CHANNELS',
-    'HOLDS',
-    'INITIAL_STATES',
-    'PAPER_DOMAINS',
-    'PARAM_UNITS',
-    'SENSOR_NAMES',
-    'ChainSpec',
-    'chain_names',
-    'chain_spec',
-    'er_percent',
-    'param_units',
-]
+__all__ = ['CHAIN_NAMES', 'CHANNELS', 'HOLDS', 'INITIAL_STATES', 'PAPER_DOMAINS', 'PARAM_UNITS',
+           'SENSOR_NAMES', 'ChainSpec', 'chain_names', 'chain_spec', 'er_percent', 'param_units']
 
 CHANNELS = ('position', 'pressure', 'flow')
 #: Sensor-dynamics parameters of each channel.
@@ -258,7 +245,9 @@ class ChainSpec:
     calibration : tuple of float or None
         Fixed ``(k, b)`` of ``y = k s + b``; ``None`` profiles it per candidate.
     domain_source : str
-        Where the bounds came from (``paper``, ``auto``, ``given``).
+        Where the bounds came from (``paper``, ``auto``, ``given``); with
+        ``paper`` the family's frame-bound constraints apply too
+        (:meth:`hyst_id.models.family.HysteresisFamily.paper_frame_rows`).
     extra : dict
         Scales of the data the domains were derived from.
     family : HysteresisFamily
@@ -273,8 +262,7 @@ class ChainSpec:
         Zero-order-hold convention of the sensor's input: sample ``j``'s value
         held over the interval before it (the default: the command changed
         right after the previous sample) or after it (a sample is taken just
-        before the command of its instant acts). Simulators and loggers
-        differ; it matters when the sensor's time constant is a few samples.
+        before the command of its instant acts; so do some simulators).
     """
 
     channel: str
@@ -356,8 +344,9 @@ class ChainSpec:
         """Boolean mask of the rows of ``pop`` that satisfy every constraint."""
         pop = np.ascontiguousarray(np.atleast_2d(pop), dtype=np.float64)
         nh = self.n_h
-        return (self.family.feasible_rows(np.ascontiguousarray(pop[:, :nh]))
-                & _tail_feasible_rows(np.ascontiguousarray(pop[:, nh:])))
+        h = np.ascontiguousarray(pop[:, :nh])
+        ok = self.family.feasible_rows(h) & _tail_feasible_rows(np.ascontiguousarray(pop[:, nh:]))
+        return ok & self.family.paper_frame_rows(h) if self.domain_source == 'paper' else ok
 
     def cost_function(self, t_s: np.ndarray, command: np.ndarray,
                       measurement: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
@@ -371,6 +360,7 @@ class ChainSpec:
         nh, family = self.n_h, self.family
         block = max(1, _BLOCK_VALUES // max(1, v.shape[0]))
         v_h, falling, hold_after = self._h_command(v), self.falling, self.hold == 'after'
+        paper_frame = self.domain_source == 'paper'
 
         def cost(pop: np.ndarray) -> np.ndarray:
             pop = np.ascontiguousarray(np.atleast_2d(pop), dtype=np.float64)
@@ -380,6 +370,8 @@ class ChainSpec:
                 h = np.ascontiguousarray(rows[:, :nh])
                 tail = np.ascontiguousarray(rows[:, nh:])
                 ok = family.feasible_rows(h) & _tail_feasible_rows(tail)
+                if paper_frame:
+                    ok &= family.paper_frame_rows(h)
                 u = np.empty((rows.shape[0], v_h.shape[0]))
                 family.simulate_rows(h, v_h, ok, u)
                 if falling:
@@ -499,10 +491,8 @@ def chain_spec(channel: str, domains: Mapping[str, tuple[float, float]] | None =
         domains must all be given (or derived from the data:
         :func:`hyst_id.identification.domains.domains_from_data`).
     calibration : tuple of float, optional
-        Fixed ``(k, b)``; default profiled (fitted per candidate), for the
-        position channel too: H and B already carry a scale and an offset, so
-        profiling adds no freedom, but it lets the search run in the
-        command's scale whatever units the measurement has.
+        Fixed ``(k, b)``; default profiled (fitted per candidate), for position
+        too (no freedom added; the search runs in any measurement units).
     family : str or HysteresisFamily, optional
         The hysteresis family (default ``tk``, the paper's).
     initial : {'rising', 'falling'}

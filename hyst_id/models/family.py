@@ -161,8 +161,21 @@ class HysteresisFamily:
         raise NotImplementedError
 
     def feasible_rows(self, pop: np.ndarray) -> np.ndarray:
-        """Search-space constraints per row of ``pop`` (``(n, n_params)``), as a bool mask."""
+        """Search-space constraints per row of ``pop`` (``(n, n_params)``), as a bool mask.
+
+        They must hold in any command frame (any positive scale and offset of
+        the command): a recording's command units are the user's.
+        """
         raise NotImplementedError
+
+    def paper_frame_rows(self, pop: np.ndarray) -> np.ndarray:
+        """Constraints of the paper that hold only in its command frame (mA), per row.
+
+        Applied on top of :meth:`feasible_rows` when the search domains are the
+        paper's own (``domain_source == 'paper'``): the paper's procedure keeps
+        its constraints as printed. Default: none.
+        """
+        return np.ones(np.atleast_2d(pop).shape[0], dtype=bool)
 
     # ----------------------------------------------------------- simulation
     def simulate_rows(self, pop: np.ndarray, v: np.ndarray, ok: np.ndarray,

@@ -76,18 +76,22 @@ PAPER_DOMAINS = {'m_l': (0.0, 5.0), 'm_r': (0.0, 5.0), 'm_t': (0.0, 5.0), 'm_b':
 def loop_is_proper(m_l, m_r, m_t, m_b, c_l, c_r, c_t, c_b):
     """Return True when the parameters describe a proper loop (gauge invariant).
 
-    Slopes ``min(m_l, m_r) > m_t, m_b > 0``, ``c_t > c_b``, and the four
-    corners form a proper quadrilateral (see :func:`loop_corners`): the left
-    line meets the bottom and the top lines before the right line does, and
-    meets the bottom before the top. These conditions survive any positive
-    rescaling and shift of the output (the gauge of ``docs/model.md``); the
-    paper's ``c_l < c_r`` does not (it compares where the lines extrapolate
-    to zero output) and is therefore only a search-space constraint
-    (:func:`hysteresis_feasible`).
+    Slopes ``min(m_l, m_r) > m_t, m_b > 0`` and the four corners form a
+    proper quadrilateral (see :func:`loop_corners`): the left line meets the
+    bottom and the top lines before the right line does, and meets the bottom
+    before the top. The corners put the top line above the bottom line over
+    the whole loop (at D: ``top(v_D) = left(v_D) > left(v_A) + m_b (v_D - v_A)
+    = bottom(v_D)``, likewise at B). These conditions survive any positive
+    rescaling and shift of the output (the gauge of ``docs/model.md``) and of
+    the command. The paper's ``c_t > c_b`` compares the lines at command 0 and
+    changes with the command's offset (a loop recorded in volts from 100 V
+    can break it), so it is kept only with the paper's own domains
+    (:meth:`TaoKokotovic.paper_frame_rows`); the paper's ``c_l < c_r``
+    compares where the lines extrapolate to zero output and is a
+    search-space constraint (:func:`hysteresis_feasible`).
     """
     m_min = min(m_l, m_r)
-    if not (m_l > 0.0 and m_r > 0.0 and 0.0 < m_t < m_min and 0.0 < m_b < m_min
-            and c_t > c_b):
+    if not (m_l > 0.0 and m_r > 0.0 and 0.0 < m_t < m_min and 0.0 < m_b < m_min):
         return False
     v_a = (c_b + m_l * c_l) / (m_l - m_b)
     v_b = (c_b + m_r * c_r) / (m_r - m_b)
@@ -205,7 +209,6 @@ def check_hysteresis(params: np.ndarray) -> np.ndarray:
         (m_l > 0 and m_r > 0, 'm_l, m_r > 0'),
         (0 < m_t < min(m_l, m_r), 'min(m_l, m_r) > m_t > 0'),
         (0 < m_b < min(m_l, m_r), 'min(m_l, m_r) > m_b > 0'),
-        (c_t > c_b, 'c_t > c_b'),
     )
     for ok, rule in checks:
         if not ok:
@@ -369,8 +372,13 @@ class TaoKokotovic(HysteresisFamily):
         return check_hysteresis(params)
 
     def feasible_rows(self, pop: np.ndarray) -> np.ndarray:
-        """The paper's constraints and a proper loop, per row."""
+        """``c_l < c_r`` and a proper loop, per row (any command frame)."""
         return _feasible_rows(np.ascontiguousarray(pop, dtype=np.float64))
+
+    def paper_frame_rows(self, pop: np.ndarray) -> np.ndarray:
+        """The paper's ``c_t > c_b`` (top above bottom at command 0), per row."""
+        pop = np.atleast_2d(pop)
+        return pop[:, 6] > pop[:, 7]
 
     def simulate_rows(self, pop: np.ndarray, v: np.ndarray, ok: np.ndarray,
                       out: np.ndarray) -> None:

@@ -103,7 +103,8 @@ def test_backlash_holds_inside_the_dead_band():
 @pytest.mark.parametrize('bad, rule', [
     ([1.0, 1.0, 1.2, 0.1, 0, 1, 10, 5], 'm_t'),
     ([1.0, 1.0, 0.1, 0.1, 1, 0, 10, 5], 'left line must stay left'),
-    ([1.0, 1.0, 0.1, 0.1, 0, 1, 5, 10], 'c_t > c_b'),
+    # top line below the bottom line over the loop: the corners say so (not c_t > c_b)
+    ([1.0, 1.0, 0.1, 0.1, 0, 1, 5, 10], 'not proper'),
     ([-1.0, 1.0, 0.1, 0.1, 0, 1, 10, 5], 'm_l'),
     ([0.714, 1.092, 0.546, 0.399, -2.623, -1.267, 6.808, 4.79], 'not proper'),
 ])
@@ -119,6 +120,30 @@ def test_canonical_sets_may_have_c_l_above_c_r_when_the_loop_is_proper():
     shifted = affine_map_output(raw, 1.0, -400.0)
     assert shifted[4] > shifted[5]
     check_hysteresis(shifted[:8])
+
+
+def test_a_loop_stays_valid_in_any_command_frame():
+    """The paper's loop commanded as u = 0.5 v - 100: same output, c_t < c_b at u = 0.
+
+    ``c_t > c_b`` compares the lines at command 0, which moves with the
+    command's offset; validation and the search over data-derived domains do
+    not require it, the paper's own domains keep it (its frame).
+    """
+    a, b = 0.5, -100.0
+    m_l, m_r, m_t, m_b, c_l, c_r, c_t, c_b = PAPER_H
+    moved = np.array([m_l / a, m_r / a, m_t / a, m_b / a, b + a * c_l, b + a * c_r,
+                      c_t - m_t * b / a, c_b - m_b * b / a])
+    assert moved[6] < moved[7]
+    check_hysteresis(moved)
+    t = np.arange(0.0, 200.0, 0.1)
+    v = 9.0 + 2.0 * np.exp(-0.01 * t) * np.sin(2 * np.pi * t / 10)
+    np.testing.assert_allclose(simulate_hysteresis(moved, a * v + b),
+                               simulate_hysteresis(PAPER_H, v), rtol=1e-9, atol=1e-9)
+    x = np.concatenate([moved, [1.0, -0.15, 0.15]])[None, :]
+    domains = {'c_l': (-200.0, 0.0), 'c_r': (-200.0, 0.0), 'c_t': (-50.0, 50.0),
+               'c_b': (-50.0, 50.0)}
+    assert chain_spec('position', domains=domains).feasible(x)[0]
+    assert not chain_spec('position').feasible(x)[0]       # the paper's domains: its frame
 
 
 def nonuniform_times(n=400, seed=0):
