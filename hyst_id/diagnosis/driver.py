@@ -18,13 +18,15 @@
 
 1. splits the record in time (default: the first 70 % trains, the rest is
    held out) and fits the paper's chain of the channel on the training part
-   (GAASS with a few seeds, refined), in a normalised command scale unless a
-   chain spec is given;
+   (:mod:`hyst_id.diagnosis.baseline`: identify with its global phase, in the
+   chain's and in data-chosen conventions), in a normalised command scale
+   unless a chain spec is given;
 2. locates the mismatch in the residual (:mod:`hyst_id.diagnosis.locate`);
 3. inserts every mechanism of the library (:mod:`hyst_id.diagnosis.mechanisms`)
    at its place in the chain, refits locally from the baseline and keeps the
-   best one the data support (:mod:`hyst_id.diagnosis.select`); repeats once
-   more if the residual still has structure;
+   best one the data support (:mod:`hyst_id.diagnosis.select`) and that more
+   than the chain's refit alone explains (:mod:`hyst_id.diagnosis.control`);
+   repeats once more if the residual still has structure;
 4. returns a :class:`Diagnosis` whose :meth:`~Diagnosis.to_dict` is the
    ``--json`` document and whose :meth:`~Diagnosis.report` is the text report.
 

@@ -42,8 +42,10 @@ class DiagnoseSettings:
     train_fraction : float
         Share of the record's duration used for fitting (the rest is held out).
     seeds, generations, pop_size, workers :
-        GAASS settings of the baseline fit (fewer seeds than the paper; each
-        result is refined by least squares).
+        GAASS settings of the baseline's two identifications (fewer seeds than
+        the paper; each result refined by least squares, then identify's
+        global phase when they end above the floor; see
+        :func:`hyst_id.diagnosis.baseline.baseline_starts`).
     mechanisms : tuple of str or None
         Mechanism ids to test (default: the whole library).
     max_mechanisms : int
