@@ -86,6 +86,7 @@ class Case:
     noise_std: float             # true, including quantisation (q^2 / 12)
     params: dict
     note: str
+    command_map: tuple = (1.0, 0.0)   # (a, b): command = a v + b, v in the params' units
 
 
 def _excitation(kind: str, t: np.ndarray, rng: np.random.Generator) -> np.ndarray:
@@ -196,7 +197,7 @@ def draw_case(index: int, base_seed: int = 2026, n_samples: int | None = None) -
     noise = float(np.sqrt(sigma ** 2 + q ** 2 / 12.0)) * abs(k)
     note = (f'{channel}, {kind}, {1 / dt:g} Hz, {n} samples, noise '
             f'{100 * sigma / span:.2g} % of span{", quantised" if q else ""}, {initial}')
-    return Case(index, channel, kind, dt, t, a * v + b, k * y + off, noise, p, note)
+    return Case(index, channel, kind, dt, t, a * v + b, k * y + off, noise, p, note, (a, b))
 
 
 def recording(case: Case):
