@@ -12,7 +12,7 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
-"""Are the true parameters of the reference family inside identify's feasible set?
+"""Whether the true parameters of the reference family lie in identify's feasible set.
 
 For recordings of ``bench/generalisation.py`` this writes the true loop in the
 recording's own command units (``command = a v + b``: slopes / a, side lines

@@ -12,7 +12,7 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
-"""The null control: is it the block, or the chain refit that came with it?
+"""The null control: the block, or the chain refit that came with it.
 
 Fitting a block polishes the whole chain again, from the current parameters
 and from the data-built starts. When the current chain had stopped short of
