@@ -21,7 +21,8 @@ record over ``--seeds`` noise seeds, each also under the round-off probe
 (``HYST_ID_ROUNDOFF_PROBE``, imitating another CPU's last bits), and the
 concealed bags under ``--probes`` probe seeds. It prints, per claim, how
 often the verdict is right and the distribution of the figures the tests
-bound (held-out gain, final held-out over the noise floor).
+bound (held-out gain, final held-out over the noise floor; for the bags also the
+explained share of the mismatch beyond the floor).
 
 Run from the repository root (about 40 minutes on 2 cores)::
 
@@ -90,10 +91,12 @@ def synthetic_spreads(mechs: list[str], seeds: list[int], probes: list[int | Non
 def bag_spreads(probes: list[int | None], names: list[str]) -> None:
     """The concealed bags under round-off probes."""
     from test_concealed_bags import CASES, SETTINGS
+
+    from hyst_id.diagnosis.select import explained_share
     print(f'concealed bags (test/diagnosis/test_concealed_bags.py), probes {probes}')
     for name in sorted(n for n in CASES if not names or n in names):
         channel, _, _, _, expected = CASES[name]
-        verdicts, gains, ratios = [], [], []
+        verdicts, gains, ratios, shares = [], [], [], []
         for probe in probes:
             _probe(probe)
             d = diagnose(read_recording(ROOT / 'bags' / name, channel), settings=SETTINGS)
@@ -101,10 +104,12 @@ def bag_spreads(probes: list[int | None], names: list[str]) -> None:
             b, f = d.baseline.er_holdout_percent, d.final.er_holdout_percent
             gains.append(1.0 - f / b)
             ratios.append(f / d.noise_floor_percent)
+            shares.append(explained_share(b, f, d.noise_floor_percent))
             if VERBOSE:
                 print(f'  {name} probe {probe}: {d.verdict}, held-out {b:.4g} -> {f:.4g}, '
                       f'floor {d.noise_floor_percent:.4g}', flush=True)
-        print(_row(f'{name} ({expected})', verdicts, gains, ratios), flush=True)
+        print(_row(f'{name} ({expected})', verdicts, gains, ratios)
+              + f'  explained share min {min(shares):.0%} max {max(shares):.0%}', flush=True)
     _probe(None)
 
 

@@ -63,13 +63,12 @@ def baseline_starts(rec_train: Recording, spec: ChainSpec, settings, *, thorough
     identify's global phase, one in the spec's conventions
     (``conventions='given'``) and one choosing them from the data
     (``'auto'``; its runs that start on the other boundary are dropped: the
-    composed model starts on the spec's). Measured on the clean recordings of
-    the blind family (bench/blind_family.py) where the old baseline (two GAASS
-    seeds, given conventions, no global phase) stopped above 1.3 x the floor
-    on its own training part: 6.1 -> 1.05 x, 2.8 -> 1.07 x, 1.6 -> 1.2 x; a
-    baseline short of the floor is what a mechanism block then fills, which
-    had made 14 of 39 clean recordings claim physics. Otherwise (a family
-    swap's refit) the quick search: GAASS seeds refined, given conventions.
+    composed model starts on the spec's). A baseline short of the floor is
+    what a mechanism block then fills: with the old baseline (two GAASS seeds,
+    given conventions, no global phase) 14 of the 39 clean recordings of the
+    blind family claimed physics, with this one and the null control 3
+    (bench/blind_family.py, docs/diagnosis.md). Otherwise (a family swap's
+    refit) the quick search: GAASS seeds refined, given conventions.
     """
     base = {'pop_size': settings.pop_size, 'maxiter': settings.generations,
             'seeds': tuple(settings.seeds), 'workers': settings.workers, 'refine': True,

@@ -203,7 +203,8 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
     sigma = noise_std(y)
     data = Data(t_s=t, v=v, y=y, n_train=n_train, noise_std=sigma,
                 judged=inside_rows(v, n_train))
-    say(f'baseline: GAASS x {len(settings.seeds)} seeds on the first {n_train} samples')
+    say(f'baseline: identify (GAASS x {len(settings.seeds)} seeds, global phase) twice on the '
+        f'first {n_train} samples')
     x_fits, starts = baseline_starts(rec_train, spec, settings)
     # a channel with a sensor has dynamics from the start: its hold convention is chosen
     # here, on the training error (a position chain is static until a filter block joins)

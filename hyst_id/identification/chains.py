@@ -107,6 +107,13 @@ def _tail_feasible_rows(tail):
     return ok
 
 
+def _rows_feasible(family: HysteresisFamily, h: np.ndarray, tail: np.ndarray,
+                   paper_frame: bool) -> np.ndarray:
+    """Every constraint per row: H's family, B's and the sensor's, the paper's frame-bound ones."""
+    ok = family.feasible_rows(h) & _tail_feasible_rows(tail)
+    return ok & family.paper_frame_rows(h) if paper_frame else ok
+
+
 @njit(cache=True)
 def _tail_signal(u, tail, kind, dt_s, uniform, falling, hold_after, out):
     """Backlash and sensor dynamics after H's output ``u``, into ``out``.
@@ -344,9 +351,8 @@ class ChainSpec:
         """Boolean mask of the rows of ``pop`` that satisfy every constraint."""
         pop = np.ascontiguousarray(np.atleast_2d(pop), dtype=np.float64)
         nh = self.n_h
-        h = np.ascontiguousarray(pop[:, :nh])
-        ok = self.family.feasible_rows(h) & _tail_feasible_rows(np.ascontiguousarray(pop[:, nh:]))
-        return ok & self.family.paper_frame_rows(h) if self.domain_source == 'paper' else ok
+        return _rows_feasible(self.family, np.ascontiguousarray(pop[:, :nh]),
+                              np.ascontiguousarray(pop[:, nh:]), self.domain_source == 'paper')
 
     def cost_function(self, t_s: np.ndarray, command: np.ndarray,
                       measurement: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
@@ -369,9 +375,7 @@ class ChainSpec:
                 rows = pop[a:a + block]
                 h = np.ascontiguousarray(rows[:, :nh])
                 tail = np.ascontiguousarray(rows[:, nh:])
-                ok = family.feasible_rows(h) & _tail_feasible_rows(tail)
-                if paper_frame:
-                    ok &= family.paper_frame_rows(h)
+                ok = _rows_feasible(family, h, tail, paper_frame)
                 u = np.empty((rows.shape[0], v_h.shape[0]))
                 family.simulate_rows(h, v_h, ok, u)
                 if falling:

@@ -453,7 +453,7 @@ def global_phase(spec: ChainSpec, rec: Recording, settings: IdentifySettings,
     with threadpool_limits(limits=1):
         res = differential_evolution(lambda x: cost(np.ascontiguousarray(x.T)), spec.bounds,
                                      maxiter=maxiter, popsize=popsize, tol=0.0, atol=0.0,
-                                     polish=False, rng=np.random.default_rng(
+                                     polish=False, rng=np.random.default_rng(  # -1: as before
                                          [seed, 7] if run_id == -1 else [seed, 7, -run_id]),
                                      vectorized=True, updating='deferred')
         x_raw, fun = np.asarray(res.x, dtype=float), float(res.fun)
