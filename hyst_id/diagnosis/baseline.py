@@ -34,10 +34,7 @@ from hyst_id.identification.chains import ChainSpec
 from hyst_id.identification.starts import data_starts, SPLITS
 from hyst_id.io.recording import Recording
 
-__all__ = ['baseline_starts', 'structured_starts', 'GLOBAL_EVALS']
-
-#: evaluations of identify's global phase in a thorough baseline (identify's default)
-GLOBAL_EVALS = 200000
+__all__ = ['baseline_starts', 'structured_starts']
 
 
 def structured_starts(spec: ChainSpec, t_s: np.ndarray, v: np.ndarray, y: np.ndarray,
@@ -75,8 +72,9 @@ def baseline_starts(rec_train: Recording, spec: ChainSpec, settings, *, thorough
             'refine_top': 2, 'restarts': 1, 'refine_max_nfev': 1500}
     runs = []
     for conventions in (('given', 'auto') if thorough else ('given',)):
+        global_evals = IdentifySettings.global_evals if thorough else 0   # identify's default
         ident = identify(rec_train, spec=spec, settings=IdentifySettings(
-            **base, conventions=conventions, global_evals=GLOBAL_EVALS if thorough else 0))
+            **base, conventions=conventions, global_evals=global_evals))
         own = [r for r in ident.runs if r.initial == spec.initial]
         if own:
             runs.append(min(own, key=lambda r: r.fun))

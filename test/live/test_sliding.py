@@ -19,6 +19,10 @@ package): a position chain identified on a stationary stretch, then windows
 from the same plant (no swap may happen), from a plant whose gain fell by
 20 % and whose offset moved (a swap must happen), and from stretches that
 cannot decide (no excitation, a command at its limit, a clipped sensor).
+Measured with this command over noise seeds 0-5, unperturbed and under
+round-off probes 1 and 2: the drifted plant swapped 18/18 (the old set 21.3 %
+%e_r, bound 10; the new set 0.06-0.12 noise std from the clean reading, bound
+3), the same plant kept 18/18 (the current set 0.91-1.11 x the floor, bound 1.3).
 """
 
 from __future__ import annotations
