@@ -23,8 +23,9 @@ key kept in that script: the named mechanism, a block that explains at least
 %e_r, a strong one absorbs part of a curved characteristic) with a held-out
 %e_r that ends within 1.5 x the noise floor, and ``none`` for the clean
 ones. The share is lowest on case_h, 56-83 % without and under three round-off
-probes (``bench/claim_spreads.py --only bags --bags case_h --probes 3``). Also the ``--sim`` mode on one bag: the simulator with the found
-effect switched on matches the recording.
+probes (``bench/claim_spreads.py --only bags --bags case_h --probes 3``).
+Also the ``--sim`` mode on one bag: the simulator with the found effect
+switched on matches the recording.
 """
 
 from __future__ import annotations
