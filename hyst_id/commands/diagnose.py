@@ -19,7 +19,10 @@ part of the record (``--train-fraction``, default 0.7) and the library of
 mechanisms is tested against the held-out rest (:mod:`hyst_id.diagnosis`).
 With ``--sim PARAMS.yaml`` the rig simulator is driven by the recording's
 command instead, its found effects are switched on and the updated
-parameters written (``--sim-out``).
+parameters written (``--sim-out``). ``--params-out FILE`` writes the
+compensator's params file from the diagnosis's final model: H and B refitted
+with the accepted blocks, and the blocks' in-line corrections
+(:mod:`hyst_id.diagnosis.export`).
 """
 
 from __future__ import annotations
@@ -54,6 +57,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     g.add_argument('--max-mechanisms', type=int, default=2,
                    help='most mechanisms added one after the other (default 2)')
     add_output_arguments(g, 'the diagnosis', 'FILE.png|DIR:write the figure')
+    g.add_argument('--params-out', metavar='FILE.yaml',
+                   help="compensator params file: the final model's H and B with the "
+                   'in-line corrections of what was found (augment.*)')
     g.add_argument('--sim', metavar='PARAMS.yaml',
                    help='compare the rig simulator with these parameters against the '
                    'recording (no baseline fit)')
@@ -81,6 +87,29 @@ def _settings(args: argparse.Namespace):
         mechanisms=mechs, max_mechanisms=args.max_mechanisms)
 
 
+def _write_params(diag, path: str) -> None:
+    from hyst_id.compensation.params_file import write_compensator_params
+    from hyst_id.diagnosis.export import compensator_set
+    from hyst_id.errors import InvalidParametersError
+
+    if diag.mode != 'model':
+        raise ConfigError('--params-out needs the model diagnosis (not --sim)')
+    try:
+        model, aug, applied = compensator_set(diag)
+    except InvalidParametersError as exc:
+        raise ConfigError(f'cannot write {path}: {exc}; identify the set with '
+                          '`hyst-id identify --params-out`') from None
+    values = {'channel': diag.channel, 'er_percent': diag.final.er_holdout_percent,
+              **model.as_mapping(), 'augment': aug}
+    write_compensator_params(values, path)
+    diag.extra['compensator'] = {'params_out': str(path),
+                                 'applied': [{'mechanism': m, 'how': how} for m, how in applied]}
+    for mech, how in applied:
+        print(f'compensator: {mech}: {how}', file=sys.stderr)
+    print(f'wrote {path} (compensator set: the final model and its in-line corrections: '
+          f'{aug.describe()})', file=sys.stderr)
+
+
 def run(args: argparse.Namespace) -> int:
     """Diagnose and print the report."""
     from hyst_id.diagnosis import diagnose
@@ -103,6 +132,8 @@ def run(args: argparse.Namespace) -> int:
         spec = None if args.domains == 'auto' else make_spec(args, rec)
         diag = diagnose(rec, spec=spec, settings=settings, progress=say)
     print(diag.report())
+    if args.params_out:
+        _write_params(diag, args.params_out)
     if updated is not None:
         from hyst_id.rig import save_rig_params
         out = Path(args.sim_out) if args.sim_out else Path(

@@ -18,11 +18,16 @@
 :class:`CommandLimits` and :class:`Compensator` (B⁻¹ then H⁻¹ with its own
 model state, atomic swaps). :mod:`.tracking` wraps it in an
 :class:`~hyst_id.compensation.tracking.AdaptiveCompensator` that tracks the
-plant's slow gain and offset from its measurement.
+plant's slow gain and offset from its measurement; :mod:`.augment` wraps it
+in an :class:`~hyst_id.compensation.augment.AugmentedCompensator` that runs
+a diagnosis's in-line corrections (dead time ahead, gain and offset
+schedules, travel stops).
 
 May import: :mod:`hyst_id.models`, :mod:`hyst_id.errors`.
 """
 
+from hyst_id.compensation.augment import Augmentation, AugmentedCompensator
 from hyst_id.compensation.inverse import CommandLimits, Compensator, InverseModel
 
-__all__ = ['CommandLimits', 'Compensator', 'InverseModel']
+__all__ = ['Augmentation', 'AugmentedCompensator', 'CommandLimits', 'Compensator',
+           'InverseModel']

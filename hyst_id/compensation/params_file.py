@@ -27,11 +27,16 @@ accepts for the compensator node, in any namespace (``/**``, so that
         c_br: 0.27
         output_sign: 1.0
         er_percent: 2.38
+        augment:              # optional: in-line corrections from a diagnosis
+          dead_time_s: 0.5
+          ...
 
 ``family`` names H's family (:mod:`hyst_id.models.registry`; a file
 without it holds the paper's ``tk`` loop) and the names that follow are
 that family's. ``output_sign`` is the canonical calibration sign (-1 for a sensor that
-falls as the actuator output rises); a file without it means +1.
+falls as the actuator output rises); a file without it means +1. ``augment``
+holds the in-line corrections of :class:`hyst_id.compensation.augment.Augmentation`
+(``hyst-id diagnose --params-out``); ROS reads them as ``augment.<field>``.
 
 Every number is written as a YAML float (``1.0``, never ``1``; ``.nan`` for
 a missing value) because ROS refuses an integer for a double parameter. The
@@ -50,7 +55,8 @@ from typing import Any, Mapping
 
 import yaml
 
-from hyst_id.errors import ConfigError
+from hyst_id.compensation.augment import AUGMENT_PREFIX, Augmentation
+from hyst_id.errors import ConfigError, InvalidParametersError
 from hyst_id.io.params_file import read_yaml
 from hyst_id.models.backlash import BACKLASH_NAMES
 from hyst_id.models.registry import DEFAULT_FAMILY, FAMILIES, get_family
@@ -123,7 +129,42 @@ def compensator_values(identification_or_dict: Any) -> dict[str, Any]:
     if out['output_sign'] not in (1.0, -1.0):
         raise ConfigError(f'output_sign must be 1.0 or -1.0, got {sign!r}')
     out['er_percent'] = math.nan if er is None else _float(er, 'er_percent')
+    aug = _augment_values(obj, params)
+    if aug:
+        out.update(aug)
     return out
+
+
+def _augment_values(*sources: Any) -> dict[str, Any]:
+    """``augment.*`` values from nested ``augment:`` mappings or dotted keys, validated."""
+    flat: dict[str, Any] = {}
+    for src in sources:
+        if not isinstance(src, Mapping):
+            aug = getattr(src, 'augmentation', None)
+            flat.update(aug.as_mapping() if isinstance(aug, Augmentation) else {})
+            continue
+        nested = src.get('augment')
+        if isinstance(nested, Mapping):
+            flat.update({AUGMENT_PREFIX + str(k): v for k, v in nested.items()})
+        elif isinstance(nested, Augmentation):
+            flat.update(nested.as_mapping())
+        flat.update({k: v for k, v in src.items() if str(k).startswith(AUGMENT_PREFIX)})
+    if not flat:
+        return {}
+    for key, inf in ((AUGMENT_PREFIX + 'min_command', -math.inf),
+                     (AUGMENT_PREFIX + 'max_command', math.inf)):
+        v = flat.get(key)
+        if isinstance(v, float) and math.isnan(v):
+            flat[key] = inf     # .nan in a file: no stop
+    known = set(Augmentation().as_mapping())
+    unknown = sorted(set(flat) - known)
+    if unknown:
+        raise ConfigError(f'unknown in-line corrections: {", ".join(unknown)} (known: '
+                          f'{", ".join(sorted(k[len(AUGMENT_PREFIX):] for k in known))})')
+    try:
+        return Augmentation.from_mapping(flat).as_mapping()
+    except InvalidParametersError as exc:
+        raise ConfigError(str(exc)) from None
 
 
 def write_compensator_params(identification_or_dict: Any, path: str | Path,
@@ -161,6 +202,14 @@ def write_compensator_params(identification_or_dict: Any, path: str | Path,
              f'    family: {values["family"]}']
     for name in compensator_names(values['family']) + ('output_sign', 'er_percent'):
         lines.append(f'    {name}: {_yaml_float(values[name])}')
+    aug = {k[len(AUGMENT_PREFIX):]: v for k, v in values.items() if k.startswith(AUGMENT_PREFIX)}
+    if aug:
+        lines.append('    augment:')
+        for name, v in aug.items():
+            # a stop at infinity is written .nan: the node reads .nan as no stop
+            text = v if isinstance(v, str) else _yaml_float(
+                math.nan if math.isinf(v) and name.endswith('_command') else v)
+            lines.append(f'      {name}: {text}')
     text = '\n'.join(lines) + '\n'
     try:
         path.parent.mkdir(parents=True, exist_ok=True)

@@ -30,10 +30,13 @@ The stage's modules, in pipeline order:
 :mod:`.result`             :class:`DiagnoseSettings`, :class:`Finding`,
                            :class:`Diagnosis`
 :mod:`.report`             text report and figure
+:mod:`.export`             the final model and its in-line corrections as
+                           the compensator's set (``--params-out``)
 =========================  ====================================================
 
 May import: :mod:`hyst_id.signals`, :mod:`hyst_id.io`, :mod:`hyst_id.models`,
-:mod:`hyst_id.solvers`, :mod:`hyst_id.identification`, :mod:`hyst_id.rig` (``--sim``).
+:mod:`hyst_id.solvers`, :mod:`hyst_id.identification`, :mod:`hyst_id.rig` (``--sim``),
+:mod:`hyst_id.compensation` (``--params-out``).
 """
 
 from hyst_id.diagnosis.driver import diagnose

@@ -145,7 +145,8 @@ def finding_from(comp: Comparison, before: FitResult, mech: Mechanism, loc: Loca
                    er_holdout_after_percent=fit.er_holdout_percent,
                    delta_bic=comp.delta_bic, holdout_z=comp.holdout_z,
                    compensation={'kind': mech.compensation,
-                                 'how': mech.compensation_note(values, ctx)})
+                                 'how': mech.compensation_note(values, ctx),
+                                 'correction': mech.correction(theta, fit.coef, info, ctx)})
 
 
 def diagnose(recording: Recording, *, spec: ChainSpec | None = None,

@@ -84,8 +84,9 @@ class Finding:
     delta_bic: float
     holdout_z: float
     alternatives: list = field(default_factory=list)
-    #: How the block is made up for in operation: ``{'kind': ..., 'how': words}``
-    #: (:data:`hyst_id.diagnosis.mechanisms.base.COMPENSATION_KINDS`).
+    #: How the block is made up for in operation: ``{'kind': ..., 'how': words,
+    #: 'correction': {augment.* values}}`` (:data:`hyst_id.diagnosis.mechanisms.base.
+    #: COMPENSATION_KINDS`; the correction is empty without an in-line one).
     compensation: dict = field(default_factory=dict)
 
     def to_dict(self) -> dict:

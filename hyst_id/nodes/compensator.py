@@ -57,7 +57,7 @@ from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from std_msgs.msg import Float64, String
 
 from hyst_id.compensation import CommandLimits, InverseModel
-from hyst_id.compensation import Compensator as CoreCompensator
+from hyst_id.compensation.augment import AugmentedCompensator
 from hyst_id.compensation.inverse import warm_up
 from hyst_id.compensation.params_file import ALL_MODEL_NAMES, compensator_names
 from hyst_id.errors import InvalidParametersError
@@ -79,6 +79,7 @@ from hyst_id.nodes.support import (
     try_publish,
     type_mismatches,
 )
+from hyst_id.nodes.support.augment import AUGMENT_PARAMS, augmentation_from_values
 from hyst_id.nodes.support.tracking import SENSOR_KEYS, TRACKING_PARAMS, TrackingLink
 
 try:  # optional: std_srvs is not a dependency of the package
@@ -138,6 +139,7 @@ PARAMS = [
     *topic_params(TOPIC_KEYS),
     *field_params(),
     *TRACKING_PARAMS,
+    *AUGMENT_PARAMS,
     Param('topics.desired_topic', DESIRED_TOPIC, 'desired output topic (std_msgs/Float64)',
           read_only=True),
     Param('topics.identified_params_topic', IDENTIFIED_PARAMS_TOPIC,
@@ -175,7 +177,8 @@ class Compensator(HystNode):
         kind, model, unset = _model_state(values)
         if model is not None:
             warm_up(model)
-        self._comp = CoreCompensator(model, _limits(values), v0=values['initial_command'])
+        self._comp = AugmentedCompensator(model, augmentation_from_values(values),
+                                          _limits(values), v0=values['initial_command'])
         self._tracking = TrackingLink(self)
         self._tracking.configure(values, self._comp)
         self._source = 'params' if model is not None else ''
@@ -206,6 +209,8 @@ class Compensator(HystNode):
                    else 'passing the desired value through unchanged')
         if model is not None:
             log.info(f'model from parameters: {self._describe(values)}')
+            if self._comp.augmentation.active:
+                log.info(f'in-line corrections: {self._comp.augmentation.describe()}')
         elif kind == 'incomplete':
             (log.error if values['require_model'] else log.warning)(
                 f'parameter set incomplete (unset: {", ".join(unset)}): {without}')
@@ -222,6 +227,11 @@ class Compensator(HystNode):
         tracking = TrackingLink.validate(values)
         if tracking:
             return tracking
+        if any(n.startswith('augment.') for n in changed):
+            try:
+                augmentation_from_values(values).limits(_limits(values))
+            except InvalidParametersError as exc:
+                return f'{exc}; keeping the last corrections'
         if values['output_sign'] not in (1.0, -1.0):
             return f'output_sign must be 1.0 or -1.0; got {values["output_sign"]!r}'
         er = values['er_percent']
@@ -251,7 +261,13 @@ class Compensator(HystNode):
     def apply_params(self, values: dict[str, Any], changed: set[str]) -> None:
         if not hasattr(self, '_comp'):
             return
-        before = (self._comp.model, self._comp.limits)
+        before = (self._comp.model, self._comp.limits, self._comp.augmentation)
+        if any(n.startswith('augment.') for n in changed):
+            aug = augmentation_from_values(values)
+            if aug != self._comp.augmentation:
+                self._comp.set_augmentation(aug)
+                src = self._source_hint or 'set_parameters'
+                self.get_logger().warning(f'in-line corrections from {src}: {aug.describe()}')
         if changed & _LIMIT_KEYS:
             self._comp.limits = _limits(values)
         if 'diagnostics_period_s' in changed:
@@ -281,7 +297,7 @@ class Compensator(HystNode):
                 else:
                     self.get_logger().info(f'parameter set incomplete (unset: '
                                            f'{", ".join(unset)})')
-        if (self._comp.model, self._comp.limits) != before:
+        if (self._comp.model, self._comp.limits, self._comp.augmentation) != before:
             self._generation += 1
             self._publish_active_set(source, values)
 
@@ -297,7 +313,10 @@ class Compensator(HystNode):
                    + ('output_sign', 'family')},
                'min_command': lim.min_command, 'max_command': lim.max_command,
                'max_rate_per_s': None if math.isinf(lim.max_rate_per_s)
-               else lim.max_rate_per_s}
+               else lim.max_rate_per_s,
+               'augment': {k: (None if isinstance(v, float) and math.isinf(v) else v)
+                           for k, v in self._comp.augmentation.as_mapping().items()}
+               if self._comp.augmentation.active else None}
         try_publish(self._set_pub, String(data=json.dumps(doc)))
 
     _source_hint = ''

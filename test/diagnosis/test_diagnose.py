@@ -30,6 +30,8 @@ import pytest
 from smooth_reference import smooth_recording
 
 from hyst_id.cli import main
+from hyst_id.compensation.augment import Augmentation
+from hyst_id.compensation.params_file import read_compensator_params
 from hyst_id.diagnosis import diagnose, DiagnoseSettings
 from hyst_id.diagnosis.locate import locate, noise_std
 from hyst_id.diagnosis.mechanisms import Context, MECHANISM_IDS, MECHANISMS
@@ -222,7 +224,9 @@ def test_json_document_has_the_issue_schema(delay_diagnosis, tmp_path):
     assert set(doc['final']) >= {'mechanisms', 'er_train_percent', 'er_holdout_percent'}
     assert doc['final']['mechanisms'] == ['dead_time']
     assert f['params']['delay_s']['unit'] == 's'
-    assert f['compensation']['kind'] == 'not in-line' and 'ahead' in f['compensation']['how']
+    assert f['compensation']['kind'] == 'in-line' and 'ahead' in f['compensation']['how']
+    assert f['compensation']['correction'] == {
+        'augment.dead_time_s': pytest.approx(f['params']['delay_s']['value'])}
 
 
 def test_status_for_diagnostics(delay_diagnosis, clean_diagnosis):
@@ -301,12 +305,22 @@ def test_cli_writes_json_and_figure(tmp_path, capsys):
                header='t,command,measurement', comments='')
     out = tmp_path / 'd.json'
     fig = tmp_path / 'd.png'
+    params = tmp_path / 'compensator.yaml'
     code = main(['diagnose', str(csv), '--seeds', '1', '--generations', '100', '--workers', '1',
-                 '--max-mechanisms', '1', '--json', str(out), '--plot', str(fig), '--quiet'])
+                 '--max-mechanisms', '1', '--json', str(out), '--plot', str(fig), '--quiet',
+                 '--params-out', str(params)])
     assert code == 0
     doc = json.loads(out.read_text())
     assert doc['verdict'] == 'offset_drift'
     rate = doc['findings'][0]['params']['rate_per_s']['value']
     assert rate == pytest.approx(0.004, rel=0.1)
+    assert doc['findings'][0]['compensation']['correction'] == {
+        'augment.offset_rate_per_s': pytest.approx(rate), 'augment.offset_reference_s':
+        pytest.approx(0.5 * (rec.t_s[-1] - rec.t_s[0]))}
     assert Path(fig).exists()
-    assert 'verdict: offset_drift' in capsys.readouterr().out
+    captured = capsys.readouterr()
+    assert 'verdict: offset_drift' in captured.out
+    assert 'compensator: offset_drift: in-line: offset_rate_per_s' in captured.err
+    back = read_compensator_params(params)
+    assert Augmentation.from_mapping(back).offset_rate_per_s == pytest.approx(rate)
+    assert doc['compensator']['applied'][0]['mechanism'] == 'offset_drift'

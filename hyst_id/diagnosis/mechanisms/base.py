@@ -43,11 +43,12 @@ import numpy as np
 __all__ = ['COMPENSATION_KINDS', 'STAGES', 'Context', 'Mechanism', 'Quantity', 'clip_theta',
            'rate_correlation']
 
-#: How a block is made up for in operation: by the compensator's tracking or the
+#: How a block is made up for in operation: by a correction in the compensator's
+#: model (:mod:`hyst_id.compensation.augment`); by the compensator's tracking or the
 #: identifier's sliding re-identification; by the command limits; by identifying
 #: another H family; not needed (the block is in the reading, not the actuator); or
 #: not at all in-line.
-COMPENSATION_KINDS = ('tracking', 'limits', 'family', 'not needed', 'not in-line')
+COMPENSATION_KINDS = ('in-line', 'tracking', 'limits', 'family', 'not needed', 'not in-line')
 
 #: Stages in signal order.
 STAGES = ('command', 'actuator', 'position', 'quantity', 'sensor', 'output')
@@ -254,6 +255,16 @@ class Mechanism:
         """Whether and how the compensator makes up for the fitted block, in words."""
         return ('not compensated in-line: the compensator inverts H and B only; the block '
                 'stays in the plant')
+
+    def correction(self, theta: np.ndarray, coef: np.ndarray, info: dict,
+                   ctx: Context) -> dict[str, float | str]:
+        """The compensator's in-line correction for the fitted block, or ``{}``.
+
+        Keys are :class:`hyst_id.compensation.augment.Augmentation` fields with
+        the ``augment.`` prefix, values in the measured channel's units, the
+        command's units and seconds (``info`` as for :meth:`describe`).
+        """
+        return {}
 
 
 def clip_theta(theta: Sequence[float], bounds: np.ndarray) -> np.ndarray:

@@ -40,7 +40,7 @@ class DeadTime(Mechanism):
     id = 'dead_time'  # noqa: A003
     title = 'transport delay between the command and the actuator'
     stage = 'command'
-    compensation = 'not in-line'
+    compensation = 'in-line'
     placement = 'command -> actuator, before the hysteresis H'
     physics = ('the actuator acts on the command it received some time ago (D/A, field bus, '
                'positioner scan, pneumatic signal line)')
@@ -93,11 +93,17 @@ class DeadTime(Mechanism):
         return score, rate_correlation(loc)
 
     def compensation_note(self, values, ctx) -> str:
-        """A delay cannot be undone from the present desired value."""
+        """Predicted ahead from the desired value's slope."""
         d = values['delay_s'].value
-        return (f'not in-line: a {d:.3g} s delay cannot be undone from the present desired '
-                f'value; send the desired value {d:.3g} s ahead (a planned trajectory) or give '
-                'the delay to the controller (a Smith predictor)')
+        return (f'in-line (augment.dead_time_s {d:.3g}): the compensator computes each command '
+                f'for the desired value {d:.3g} s ahead, extrapolated from its recent slope; '
+                'exact for ramps, late at a reversal of the desired value by the delay. A '
+                'desired value known ahead (a planned trajectory) or a Smith predictor in the '
+                'controller does better')
+
+    def correction(self, theta, coef, info, ctx) -> dict[str, float | str]:
+        """Predict the desired value ahead by the delay."""
+        return {'augment.dead_time_s': float(theta[0])}
 
 
 MECHANISM = DeadTime()

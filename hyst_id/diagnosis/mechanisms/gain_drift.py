@@ -44,6 +44,7 @@ class GainDrift(TimeGain):
     title = 'plant or sensor gain growing over time'
     physics = ('the sensitivity rises during the run (a sensor or amplifier warming up, '
                'temperature), so the same travel reads more later in the run')
+    gain_law = 'linear'
     names = ('growth_per_s',)
     units = ('1/s',)
     rate_range = (0.001, 2.0)         # 0.1 % to 200 % over the training part

@@ -38,7 +38,7 @@ class OffsetDrift(Mechanism):
     id = 'offset_drift'  # noqa: A003
     title = 'slow additive drift of the sensor offset'
     stage = 'output'
-    compensation = 'tracking'
+    compensation = 'in-line'
     placement = 'added to the measurement after the calibration'
     physics = ("the sensor's zero moves slowly (warm-up, temperature, reference drift), "
                'independently of the command')
@@ -74,10 +74,20 @@ class OffsetDrift(Mechanism):
                                  't': loc.trend['t']}}
 
     def compensation_note(self, values, ctx) -> str:
-        """Followed online, not extrapolated."""
-        return ('tracked, not extrapolated: the tracking of the compensator (tracking.enabled) '
-                'follows the offset from the measurement (the sliding re-identification '
-                'refits it too); a sensor re-zeroed before the run removes the cause')
+        """Scheduled in-line from the run's start, and followed online."""
+        r = values['rate_per_s']
+        return (f'in-line as a ramp (augment.offset_rate_per_s {r.value:+.3g} {r.unit}): the '
+                'compensator shifts the desired value by the drift since its start, which '
+                "holds for runs that start as this record did and is held beyond the record's "
+                'length; otherwise the tracking of the compensator (tracking.enabled) follows '
+                'the offset from the measurement; a sensor re-zeroed before the run removes '
+                'the cause')
+
+    def correction(self, theta, coef, info, ctx) -> dict[str, float | str]:
+        """The drift rate; the set identified without it holds at the record's mean time."""
+        rate = float(info['coef'][info['labels'].index('offset_drift:0')])
+        return {'augment.offset_rate_per_s': rate,
+                'augment.offset_reference_s': float(np.mean(ctx.t_s - ctx.t_s[0]))}
 
 
 MECHANISM = OffsetDrift()

@@ -121,5 +121,16 @@ class Saturation(Mechanism):
         return ('by the command limits: a desired value beyond the stops cannot be reached, '
                 'and commands beyond them only wind the loop up' + where)
 
+    def correction(self, theta, coef, info, ctx) -> dict[str, float | str]:
+        """Command limits where the actuator meets its stops (in the command's units)."""
+        values = self.describe(theta, coef, info, ctx)
+        out: dict[str, float | str] = {}
+        for side, key in (('low', 'augment.min_command'), ('high', 'augment.max_command')):
+            q = values.get(f'command_at_{side}_stop')
+            if q is not None:
+                out[key] = float(q.value)
+        return out if out.get('augment.min_command', -np.inf) < out.get(
+            'augment.max_command', np.inf) else {}
+
 
 MECHANISM = Saturation()

@@ -45,6 +45,7 @@ class SupplyDecay(TimeGain):
     title = 'plant gain decaying over time (supply running down)'
     physics = ('the supply pressure falls during the run (vessels emptying without '
                'regulation), so pressure and flow for a given opening fall with it')
+    gain_law = 'exponential'
     names = ('decay_rate_per_s',)
     units = ('1/s',)
     rate_range = (0.01, 5.0)          # a hundredth to five e-foldings
@@ -74,14 +75,6 @@ class SupplyDecay(TimeGain):
                 'later in the run. Regulate the supply pressure, or schedule the gain on the '
                 'measured supply pressure; an identification from an early run will '
                 'over-predict later ones.')
-
-    def compensation_note(self, values, ctx) -> str:
-        """Followed online, not extrapolated."""
-        return ('tracked, not extrapolated: the tracking of the compensator '
-                '(tracking.enabled) follows the falling gain from the measurement, and the '
-                'sliding re-identification of the identifier (sliding.enabled) swaps in a '
-                'refitted set once the change is clear on the newest samples; a regulated '
-                'supply removes the cause')
 
 
 MECHANISM = SupplyDecay()

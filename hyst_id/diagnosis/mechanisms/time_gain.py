@@ -16,11 +16,13 @@
 
 Placement: ``y = g(t) (k s + b0) + b1`` with ``g(t0) = 1``; ``b0`` is a linear
 parameter (the offset scaled with the gain), so the block adds one searched
-parameter, a rate. A subclass says how the gain changes (:meth:`TimeGain.gain`)
-and over which range of changes over the training part its rate is searched
-(:attr:`TimeGain.rate_range`, :attr:`TimeGain.start_changes`). Both are
-followed online rather than extrapolated (the compensator's tracking, the
-identifier's sliding re-identification).
+parameter, a rate. A subclass says how the gain changes (:meth:`TimeGain.gain`,
+:attr:`TimeGain.gain_law`) and over which range of changes over the training
+part its rate is searched (:attr:`TimeGain.rate_range`,
+:attr:`TimeGain.start_changes`). In operation the fitted schedule is an
+in-line correction of the compensator (:mod:`hyst_id.compensation.augment`,
+for runs that start as the record did) and the compensator's tracking or the
+identifier's sliding re-identification follow it from the measurement.
 """
 
 from __future__ import annotations
@@ -38,7 +40,9 @@ class TimeGain(Mechanism):
     stage = 'output'
     placement = 'on the sensed quantity (a gain in time), before the sensor offset'
     n_linear = 1
-    compensation = 'tracking'
+    compensation = 'in-line'
+    #: The compensator's name for :meth:`gain` (:data:`hyst_id.compensation.augment.GAIN_LAWS`).
+    gain_law = 'none'
     #: Rate bounds as changes over the training duration (per that duration).
     rate_range: tuple[float, float] = (0.01, 5.0)
     #: Starting rates, same unit.
@@ -75,8 +79,24 @@ class TimeGain(Mechanism):
                                  'level_t': loc.trend['level_t']}}
 
     def compensation_note(self, values, ctx) -> str:
-        """Followed online, not extrapolated."""
-        return ('tracked, not extrapolated: the tracking of the compensator '
+        """Scheduled in-line from the run's start, and followed online."""
+        return ('in-line as a schedule (augment.gain_*): the compensator scales the desired '
+                'value by the fitted gain at the time since its start, which holds for runs '
+                'that start as this record did and is held at its end value beyond the '
+                "record's length; for runs that do not, the tracking of the compensator "
                 '(tracking.enabled) follows the gain from the measurement, and the sliding '
                 're-identification of the identifier (sliding.enabled) swaps in a refitted '
                 'set once the change is clear on the newest samples')
+
+    def correction(self, theta, coef, info, ctx) -> dict[str, float | str]:
+        """The gain law and rate, the reading it leaves unchanged, the record's mean gain.
+
+        ``y = g(t) (k s + b0) + b1``: the gain leaves ``b1`` unchanged. A set
+        identified on the whole record without the block holds on about the
+        record's mean gain, which becomes the schedule's reference.
+        """
+        rate = float(theta[0])
+        centre = float(info['coef'][info['labels'].index('offset')])
+        mean_gain = float(np.mean(self.gain(rate, ctx.t_s - ctx.t_s[0])))
+        return {'augment.gain_law': self.gain_law, 'augment.gain_rate_per_s': rate,
+                'augment.gain_centre': centre, 'augment.gain_reference': mean_gain}

@@ -1,0 +1,349 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""The compensator's model augmented with what a diagnosis accepted (issue 17).
+
+:class:`Augmentation` holds in-line corrections around H⁻¹ and B⁻¹, each
+from a diagnosis block (``Mechanism.correction``), in the measured channel's
+units and seconds:
+
+* ``dead_time_s`` (``dead_time``): the actuator acts ``L`` late, so the
+  command at ``t`` is computed for the desired value at ``t + L``, predicted
+  by the desired value's slope over the last ``predict_window_s`` (default 0:
+  the last two samples; longer averages a noisy desired value but lags by
+  half the window): ``d(t + L) ~ d(t) + L d'(t)``.
+* a gain schedule (``supply_decay``: ``g = exp(-rate t)``, ``gain_drift``:
+  ``g = 1 + rate t``) around ``gain_centre`` (the reading the gain leaves
+  unchanged) and an offset ramp (``offset_drift``): the reading is
+  ``y = c + g(t) / g_ref (y_model - c) + rate (t - t_ref)`` and the model is
+  asked for ``(d - c - rate (t - t_ref)) g_ref / g(t) + c``. ``g_ref`` and
+  ``t_ref`` say when the compensator's own H and B hold (a set identified on
+  the whole record without the block holds on the record's average gain and
+  offset: the defaults :func:`augmentation_from_findings` writes). ``t`` is
+  the time since the compensator's start (its first stamped sample after
+  :meth:`AugmentedCompensator.reset`): a schedule holds for runs that start
+  as the recording did (a supply vessel full again); it is held at its value
+  at ``schedule_horizon_s`` (the fitted record's length) beyond that, and
+  the gain never falls below :data:`MIN_GAIN`.
+* command limits (``saturation``): ``min_command``/``max_command`` at the
+  stops.
+
+What has no in-line correction stays in the plant and the diagnosis report
+says so (``compensation.how``); the compensator's tracking
+(:mod:`hyst_id.compensation.tracking`) follows a drift from the measurement
+instead of a fitted schedule.
+
+May import: numpy, :mod:`hyst_id.compensation.inverse`.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import asdict, dataclass, fields, replace
+import math
+from typing import Any, Iterable, Mapping
+
+import numpy as np
+
+from hyst_id.compensation.inverse import CommandLimits, Compensator, InverseModel
+from hyst_id.errors import InvalidParametersError
+
+__all__ = ['AUGMENT_PREFIX', 'Augmentation', 'AugmentedCompensator', 'GAIN_LAWS', 'MIN_GAIN',
+           'augmentation_from_findings']
+
+#: Prefix of the augmentation's keys in a params file (``augment.dead_time_s`` ...).
+AUGMENT_PREFIX = 'augment.'
+#: Gain laws of a schedule: none, ``exp(-rate t)``, ``1 + rate t``.
+GAIN_LAWS = ('none', 'exponential', 'linear')
+#: The scheduled gain is never taken below this share of its reference.
+MIN_GAIN = 0.05
+
+
+@dataclass(frozen=True)
+class Augmentation:
+    """In-line corrections around H⁻¹ (see the module docstring for each field)."""
+
+    dead_time_s: float = 0.0
+    predict_window_s: float = 0.0
+    gain_law: str = 'none'
+    gain_rate_per_s: float = 0.0
+    gain_centre: float = 0.0
+    gain_reference: float = 1.0
+    offset_rate_per_s: float = 0.0
+    offset_reference_s: float = 0.0
+    schedule_horizon_s: float = 0.0
+    min_command: float = -math.inf
+    max_command: float = math.inf
+
+    def __post_init__(self) -> None:
+        if self.gain_law not in GAIN_LAWS:
+            raise InvalidParametersError(f'augment.gain_law must be one of {GAIN_LAWS}, '
+                                         f'got {self.gain_law!r}')
+        for f in fields(self):
+            v = getattr(self, f.name)
+            if f.name != 'gain_law' and (not isinstance(v, (int, float)) or math.isnan(v)):
+                raise InvalidParametersError(f'augment.{f.name} must be a number, got {v!r}')
+        if not (math.isfinite(self.dead_time_s) and self.dead_time_s >= 0.0):
+            raise InvalidParametersError('augment.dead_time_s must be finite and >= 0')
+        if not self.predict_window_s >= 0.0 or not self.schedule_horizon_s >= 0.0:
+            raise InvalidParametersError('augment.predict_window_s and '
+                                         'augment.schedule_horizon_s must be >= 0')
+        if not self.gain_reference > 0.0:
+            raise InvalidParametersError('augment.gain_reference must be > 0')
+        if not self.min_command < self.max_command:
+            raise InvalidParametersError('augment.min_command must be < augment.max_command')
+
+    @property
+    def active(self) -> bool:
+        """Whether any correction changes what the plain compensator does."""
+        return self != replace(Augmentation(), predict_window_s=self.predict_window_s,
+                               gain_centre=self.gain_centre,
+                               gain_reference=self.gain_reference,
+                               offset_reference_s=self.offset_reference_s,
+                               schedule_horizon_s=self.schedule_horizon_s)
+
+    @property
+    def uses_time(self) -> bool:
+        """Whether the corrections need sample times."""
+        return (self.dead_time_s > 0.0 or self.gain_law != 'none'
+                or self.offset_rate_per_s != 0.0)
+
+    @classmethod
+    def from_mapping(cls, values: Mapping[str, Any]) -> Augmentation:
+        """Build from ``augment.*`` keys (others ignored); absent keys keep their defaults.
+
+        Raises
+        ------
+        InvalidParametersError
+            A value of the wrong type or out of range.
+        """
+        kw: dict[str, Any] = {}
+        for f in fields(cls):
+            key = AUGMENT_PREFIX + f.name
+            if key not in values:
+                continue
+            v = values[key]
+            if f.name == 'gain_law':
+                kw[f.name] = str(v)
+                continue
+            try:
+                if isinstance(v, bool):
+                    raise TypeError
+                kw[f.name] = float(v)
+            except (TypeError, ValueError):
+                raise InvalidParametersError(f'{key} must be a number, got {v!r}') from None
+        return cls(**kw)
+
+    def as_mapping(self) -> dict[str, Any]:
+        """``augment.*`` key -> value, as a params file holds them."""
+        return {AUGMENT_PREFIX + k: v for k, v in asdict(self).items()}
+
+    def describe(self) -> str:
+        """The active corrections in a few words (``none`` without any)."""
+        parts = []
+        if self.dead_time_s > 0.0:
+            parts.append(f'predict {self.dead_time_s:.4g} s ahead')
+        if self.gain_law != 'none':
+            parts.append(f'{self.gain_law} gain schedule {self.gain_rate_per_s:+.4g}/s around '
+                         f'{self.gain_centre:.4g} (set at gain {self.gain_reference:.4g})')
+        if self.offset_rate_per_s != 0.0:
+            parts.append(f'offset ramp {self.offset_rate_per_s:+.4g}/s')
+        if self.schedule_horizon_s > 0.0 and (self.gain_law != 'none'
+                                              or self.offset_rate_per_s != 0.0):
+            parts.append(f'schedules held after {self.schedule_horizon_s:.4g} s')
+        if math.isfinite(self.min_command) or math.isfinite(self.max_command):
+            parts.append(f'stops [{self.min_command:.4g}, {self.max_command:.4g}]')
+        return ', '.join(parts) or 'none'
+
+    def limits(self, base: CommandLimits) -> CommandLimits:
+        """``base`` narrowed to the stops."""
+        lo = max(base.min_command, self.min_command)
+        hi = min(base.max_command, self.max_command)
+        if not lo < hi:
+            raise InvalidParametersError(f'the stops [{self.min_command}, {self.max_command}] '
+                                         f'leave no command inside [{base.min_command}, '
+                                         f'{base.max_command}]')
+        return CommandLimits(lo, hi, base.max_rate_per_s)
+
+    def gain(self, elapsed_s: float) -> float:
+        """Scheduled gain relative to the model's (``g(t) / g_ref``), at least :data:`MIN_GAIN`."""
+        if self.gain_law == 'none':
+            return 1.0
+        t = self._held(elapsed_s)
+        g = (math.exp(-self.gain_rate_per_s * t) if self.gain_law == 'exponential'
+             else 1.0 + self.gain_rate_per_s * t)
+        return max(g / self.gain_reference, MIN_GAIN)
+
+    def offset(self, elapsed_s: float) -> float:
+        """Offset relative to the model's at ``elapsed_s``."""
+        if self.offset_rate_per_s == 0.0:
+            return 0.0
+        return self.offset_rate_per_s * (self._held(elapsed_s) - self.offset_reference_s)
+
+    def model_target(self, desired: float, elapsed_s: float) -> float:
+        """What the model must output so that the reading is ``desired`` at ``elapsed_s``."""
+        c = self.gain_centre
+        return (desired - c - self.offset(elapsed_s)) / self.gain(elapsed_s) + c
+
+    def _held(self, elapsed_s: float) -> float:
+        t = max(float(elapsed_s), 0.0)
+        return min(t, self.schedule_horizon_s) if self.schedule_horizon_s > 0.0 else t
+
+
+class AugmentedCompensator:
+    """A :class:`Compensator` with an :class:`Augmentation` around it.
+
+    Same interface as :class:`Compensator` (``step``, ``run``, ``reset``,
+    ``set_model``, ``bypass``, ``state``); :meth:`set_augmentation` swaps
+    the corrections between two samples, as ``set_model`` swaps the set.
+
+    Parameters
+    ----------
+    model : InverseModel or None
+        H and B (``None``: pass-through, corrections off).
+    augmentation : Augmentation, optional
+        Corrections (default none: exactly the plain compensator).
+    limits : CommandLimits, optional
+        Command limits; the augmentation's stops narrow them.
+    v0 : float
+        Command held before the first sample.
+    """
+
+    def __init__(self, model: InverseModel | None, augmentation: Augmentation | None = None,
+                 limits: CommandLimits | None = None, v0: float = 0.0) -> None:
+        self.base_limits = limits or CommandLimits()
+        self.augmentation = augmentation or Augmentation()
+        self.inner = Compensator(model, self.augmentation.limits(self.base_limits), v0)
+        self._history: deque[tuple[float, float]] = deque()
+        self._t0: float | None = None
+
+    @property
+    def model(self) -> InverseModel | None:
+        """The parameter set in use."""
+        return self.inner.model
+
+    @property
+    def state(self) -> tuple[float, float, float]:
+        """The inner compensator's ``(v, u, y)``."""
+        return self.inner.state
+
+    @property
+    def limits(self) -> CommandLimits:
+        """Limits in force: the base limits narrowed to the stops."""
+        return self.inner.limits
+
+    @limits.setter
+    def limits(self, base: CommandLimits) -> None:
+        self.inner.limits = self.augmentation.limits(base)
+        self.base_limits = base
+
+    @property
+    def bypass(self) -> bool:
+        """Pass the desired value through (corrections off too)."""
+        return self.inner.bypass
+
+    @bypass.setter
+    def bypass(self, value: bool) -> None:
+        self.inner.bypass = bool(value)
+
+    def reset(self, v0: float) -> None:
+        """Reset the model state and the schedule's time origin."""
+        self.inner.reset(v0)
+        self._history.clear()
+        self._t0 = None
+
+    def set_model(self, model: InverseModel | None) -> None:
+        """Swap H and B between samples (see :meth:`Compensator.set_model`)."""
+        self.inner.set_model(model)
+
+    def set_augmentation(self, augmentation: Augmentation) -> None:
+        """Swap the corrections between samples (the schedule's time origin is kept)."""
+        self.inner.limits = augmentation.limits(self.base_limits)
+        self.augmentation = augmentation
+
+    def predicted_desired(self, desired: float, t_s: float | None) -> float:
+        """The desired value ``dead_time_s`` ahead, from its recent slope."""
+        aug = self.augmentation
+        if aug.dead_time_s <= 0.0 or t_s is None:
+            return desired
+        hist = self._history
+        hist.append((t_s, desired))
+        while len(hist) > 2 and t_s - hist[1][0] >= aug.predict_window_s:
+            hist.popleft()
+        t_old, d_old = hist[0]
+        if t_s - t_old <= 0.0:
+            return desired
+        return desired + aug.dead_time_s * (desired - d_old) / (t_s - t_old)
+
+    def step(self, desired: float, t_s: float | None = None) -> float:
+        """Command for one desired output sample (``t_s`` needed by time-based corrections)."""
+        aug = self.augmentation
+        if self.inner.model is None or self.inner.bypass or not aug.active:
+            return self.inner.step(desired, t_s)
+        if t_s is not None and self._t0 is None:
+            self._t0 = float(t_s)
+        target = self.predicted_desired(float(desired), t_s)
+        if t_s is not None:
+            target = aug.model_target(target, t_s - self._t0 + aug.dead_time_s)
+        return self.inner.step(target, t_s)
+
+    def run(self, desired: np.ndarray, t_s: np.ndarray | None = None) -> np.ndarray:
+        """Commands for a whole desired sequence."""
+        if t_s is None and self.augmentation.uses_time:
+            raise InvalidParametersError('time-based corrections need the sample times')
+        out = np.empty(len(desired))
+        for j, d in enumerate(desired):
+            out[j] = self.step(float(d), None if t_s is None else float(t_s[j]))
+        return out
+
+
+def augmentation_from_findings(findings: Iterable[Any], record_duration_s: float
+                               ) -> tuple[Augmentation, list[tuple[str, str]]]:
+    """The corrections of a diagnosis's accepted findings, and what each one became.
+
+    Parameters
+    ----------
+    findings : iterable
+        :class:`hyst_id.diagnosis.result.Finding` objects or their JSON dicts;
+        each ``compensation['correction']`` holds ``augment.*`` values.
+    record_duration_s : float
+        Length of the diagnosed record: the schedules are held beyond it.
+
+    Returns
+    -------
+    augmentation : Augmentation
+    applied : list of (mechanism, words)
+        Per finding, whether and how the compensator now makes up for it.
+    """
+    values: dict[str, Any] = {}
+    applied: list[tuple[str, str]] = []
+    for f in findings:
+        d = f if isinstance(f, Mapping) else f.to_dict()
+        corr = dict((d.get('compensation') or {}).get('correction') or {})
+        if not corr:
+            applied.append((d['mechanism'], 'no in-line correction: '
+                            + str((d.get('compensation') or {}).get('how', ''))))
+            continue
+        clash = sorted(set(corr) & set(values))
+        if clash:
+            applied.append((d['mechanism'], 'not applied: ' + ', '.join(clash)
+                            + ' already set by an earlier finding'))
+            continue
+        values.update(corr)
+        applied.append((d['mechanism'], 'in-line: ' + ', '.join(
+            f'{k[len(AUGMENT_PREFIX):]} = {v if isinstance(v, str) else f"{v:.4g}"}'
+            for k, v in corr.items())))
+    if any(k.startswith(AUGMENT_PREFIX + p) for k in values for p in ('gain', 'offset')):
+        values.setdefault(AUGMENT_PREFIX + 'schedule_horizon_s', float(record_duration_s))
+    return Augmentation.from_mapping(values), applied
