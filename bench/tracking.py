@@ -33,18 +33,14 @@ import argparse
 from pathlib import Path
 import sys
 
-import numpy as np
 
 sys.path[:0] = [str(Path(__file__).resolve().parents[1] / 'test'),
                 str(Path(__file__).resolve().parents[1] / 'test' / 'compensation')]
 
-from hyst_id.compensation import CommandLimits, Compensator, InverseModel  # noqa: E402, I100
-from hyst_id.compensation.tracking import (AdaptiveCompensator,  # noqa: E402
-                                           GainOffsetTracker, SensorPredictor)
+from hyst_id.compensation import CommandLimits  # noqa: E402, I100
 from hyst_id.experiment import run_experiment  # noqa: E402
+from hyst_id.experiment.columns import closed_loop_tracking  # noqa: E402
 from hyst_id.experiment.run import CLEAN_SERIES, eps_c_percent  # noqa: E402
-from hyst_id.identification.chains import chain_spec  # noqa: E402
-from hyst_id.rig.simulator import RigSimulator  # noqa: E402
 import test_tracking as drifting  # noqa: E402, I100, I201
 
 
@@ -61,24 +57,8 @@ def drifting_plant(seeds: int) -> None:
 
 
 def _closed_loop(rig, t, desired, x, sign, channel, seed, forget_s):
-    comp = Compensator(InverseModel.from_vector(x, sign), CommandLimits(4.0, 20.0), v0=4.0)
-    adaptive = None
-    if forget_s is not None:
-        sensor = tuple(x[chain_spec(channel).sensor_slice])
-        adaptive = AdaptiveCompensator(comp, GainOffsetTracker(forget_time_s=forget_s),
-                                       SensorPredictor.for_channel(channel, sensor))
-    sim = RigSimulator(rig, seed=seed, t0_s=float(t[0]))
-    out = np.empty(t.size)
-    for k in range(t.size):
-        dt = 0.0 if k == 0 else float(t[k] - t[k - 1])
-        v = comp.step(float(desired[k])) if adaptive is None else \
-            adaptive.step(float(desired[k]), float(t[k]))
-        s = sim.step(v, dt)
-        out[k] = {'position': s.position, 'pressure': s.pressure_pa,
-                  'flow': s.flow_g_s}[channel]
-        if adaptive is not None:
-            adaptive.observe(out[k], float(t[k]), dt)
-    return out, adaptive
+    return closed_loop_tracking(rig, t, desired, x, sign, channel, seed, forget_s,
+                                CommandLimits(4.0, 20.0))
 
 
 def paper_rig(seeds: int, forgets: list[float]) -> None:

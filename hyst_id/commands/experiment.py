@@ -15,7 +15,10 @@
 """``hyst-id experiment``: reproduce the paper's section 4 on the simulated rig.
 
 Identification from the three sensors (Eq. 24, ten GAASS seeds), Table 1,
-compensation with Eq. 25 and %ε_c (Eq. 26), Figs. 2 and 4-7. Writes
+compensation with Eq. 25 and %ε_c (Eq. 26), Figs. 2 and 4-7; and issue 17's
+columns: (a) the paper's fixed H⁻¹, (b) the model augmented with what a
+diagnosis of the identification run found, (c) adaptive tracking
+(``--no-adaptive`` skips (b) and (c)). Writes
 ``results.json``, ``results.md`` and the PNG figures into ``--out`` and prints
 the headline tables; see ``docs/RESULTS.md``.
 """
@@ -27,15 +30,18 @@ from pathlib import Path
 import shutil
 import sys
 
+from hyst_id.diagnosis import DiagnoseSettings
 from hyst_id.errors import ConfigError
 from hyst_id.identification import IdentifySettings
 
-__all__ = ['add_arguments', 'run', 'QUICK_SETTINGS', 'DEFAULT_PARAMS']
+__all__ = ['add_arguments', 'run', 'QUICK_DIAGNOSIS', 'QUICK_SETTINGS', 'DEFAULT_PARAMS']
 
 DEFAULT_PARAMS = 'params/paper_rig.yaml'
 #: ``--quick``: a short GAASS and a light refinement, for tests and smoke runs.
 QUICK_SETTINGS = IdentifySettings(maxiter=150, seeds=(0, 1), restarts=1, refine_top=1,
                                   refine_max_nfev=600)
+#: ``--quick``: one GAASS seed and a short run for the diagnosis of columns (b)/(c).
+QUICK_DIAGNOSIS = DiagnoseSettings(seeds=(0,), generations=120, max_mechanisms=2)
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -60,6 +66,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--copy-figures', metavar='DIR', default=None,
                         help='also copy the Fig. 4-7 PNGs into DIR (e.g. docs/figures)')
     parser.add_argument('--no-fig2', action='store_true', help='skip Fig. 2 (GAASS on F1)')
+    parser.add_argument('--no-adaptive', action='store_true',
+                        help="skip issue 17's columns (b) augmented by a diagnosis of the "
+                        'identification run and (c) adaptive tracking')
     parser.add_argument('--quiet', action='store_true', help='no progress bar')
 
 
@@ -84,7 +93,7 @@ def _command_line(args: argparse.Namespace) -> str:
     if args.seeds is not None:
         parts.append(f'--seeds {args.seeds}')
     parts += [f'--regulation {args.regulation}']
-    for flag in ('gaass_only', 'quick', 'no_fig2'):
+    for flag in ('gaass_only', 'quick', 'no_fig2', 'no_adaptive'):
         if getattr(args, flag):
             parts.append('--' + flag.replace('_', '-'))
     if args.compensate_with != 'best':
@@ -127,7 +136,8 @@ def run(args: argparse.Namespace) -> int:
         result = run_experiment(params, settings=settings, seeds=n_seeds,
                                 regulation=regulation, modes=modes,
                                 config=ExperimentConfig(compensate_with=args.compensate_with),
-                                progress=progress)
+                                progress=progress, adaptive=not args.no_adaptive,
+                                diagnose_settings=QUICK_DIAGNOSIS if args.quick else None)
     finally:
         if bar is not None:
             bar.close()

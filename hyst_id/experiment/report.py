@@ -201,6 +201,35 @@ def _compensation_table(result: ExperimentResult) -> list[str]:
     return _table(head, rows)
 
 
+#: Issue 17's targets for %ε_c on the unregulated paper rig.
+ADAPTIVE_TARGETS = {'position': 0.4, 'pressure': 1.5, 'flow': 3.0}
+
+
+def _adaptive_table(result: ExperimentResult) -> list[str]:
+    """Issue 17: (a) fixed H⁻¹, (b) augmented by the diagnosis, (c) tracking.
+
+    The *perfect compensator* column is %ε_c of a reading that is exactly the
+    desired value through the calibration's lag: how far the desired value
+    itself is from the reference, a floor no compensator can beat.
+    """
+    head = ['supply', 'sensor', 'mode', '(a) fixed', '(b) augmented', '(c) tracking',
+            'target', 'perfect compensator (a) / (b)',
+            'diagnosis of the identification run: what (b) does with it']
+    rows = []
+    for key, sc in result.scenarios.items():
+        for (mode, ch), r in sc.channels.items():
+            a = r.adaptive
+            if a is None:
+                continue
+            how = '; '.join(f'{m}: {h.split(":")[0]}' for m, h in a.applied) or 'nothing found'
+            rows.append([f'reg. {key}', ch, _MODE_NAME[mode], _f(r.eps_c_percent),
+                         _f(a.eps_c_augmented_percent), _f(a.eps_c_tracking_percent),
+                         f'<= {ADAPTIVE_TARGETS[ch]:g}',
+                         f'{_f(a.floor_percent[0])} / {_f(a.floor_percent[1])}',
+                         f'{a.verdict} -> {how} (set from the {a.augmented_from})'])
+    return _table(head, rows) if rows else []
+
+
 def _decay_table(result: ExperimentResult) -> list[str]:
     """%ε_c with the supply decay in neither, one or both of identification and compensation."""
     if not {'off', 'on'} <= set(result.scenarios):
@@ -242,6 +271,10 @@ def format_markdown(result: ExperimentResult, command: str | None = None) -> str
                   f'identification run, {supply_drop_percent(sc):.1f} % over each compensation '
                   'run.',
                   '']
+    adaptive = _adaptive_table(result)
+    if adaptive:
+        lines += ['## Compensation with what the diagnosis found (issue 17): %ε_c, '
+                  'position-equivalent', ''] + adaptive
     lines += ['## %e_r (Eq. 7): raw units and position-equivalent', '']
     lines += _er_table(result)
     lines += ['## Position calibration of the readings (identification run)', '']

@@ -24,6 +24,7 @@ JSON form (:func:`result_to_dict`). Computation is in
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -33,7 +34,8 @@ from hyst_id.identification.chains import CHAIN_NAMES
 from hyst_id.identification.gauge import canonical_gauge
 from hyst_id.rig import RigParams, RigRun
 
-__all__ = ['CHANNELS', 'CLEAN_SERIES', 'MODES', 'ExperimentConfig', 'Calibration', 'ChannelResult',
+__all__ = ['CHANNELS', 'CLEAN_SERIES', 'MODES', 'eps_c_percent', 'ExperimentConfig',
+           'Calibration', 'ChannelResult',
            'ScenarioResult', 'ExperimentResult', 'result_to_dict', 'supply_drop_percent']
 
 
@@ -43,6 +45,16 @@ MODES = ('refined', 'gaass')
 #: Truth series of each channel's noise-free reading.
 CLEAN_SERIES = {'position': 'position_clean', 'pressure': 'pressure_clean_pa',
                 'flow': 'flow_clean_g_s'}
+
+
+def eps_c_percent(w_c: np.ndarray, w_ud: np.ndarray, offset: float = 0.0) -> float:
+    """Average percentage control error, Eq. 26, of signals measured from ``offset``.
+
+    ``offset`` is the reading at zero position (a calibration's ``b``): the
+    error is then relative to the position-equivalent signal (``k`` cancels).
+    """
+    w_c, w_ud = np.asarray(w_c, dtype=float), np.asarray(w_ud, dtype=float)
+    return float(np.sqrt(np.sum((w_c - w_ud) ** 2) / np.sum((w_ud - offset) ** 2)) * 100.0)
 
 
 @dataclass(frozen=True)
@@ -130,6 +142,9 @@ class ChannelResult:
     top_line_reached: bool         # the identified top line met inside the identification
     #                                range by more than 1 % of its span
     eps_c_other_supply_percent: float = float('nan')  # same command, other supply setting
+    #: Issue 17's columns (b) augmented and (c) tracking
+    #: (:class:`hyst_id.experiment.columns.AdaptiveColumns`), when run.
+    adaptive: Any = None
 
 
 @dataclass
@@ -209,7 +224,8 @@ def result_to_dict(result: ExperimentResult) -> dict:
                 'position_rms_error': r.position_rms_error,
                 'eps_c_other_supply_percent': r.eps_c_other_supply_percent,
                 'desired': r.desired.tolist(), 'command_ma': r.command_ma.tolist(),
-                'w_c': r.run.measurement(ch).tolist()}
+                'w_c': r.run.measurement(ch).tolist(),
+                'adaptive': None if r.adaptive is None else r.adaptive.to_dict()}
         out['scenarios'][key] = d
     return out
 

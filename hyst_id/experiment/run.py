@@ -33,6 +33,10 @@ the paper, and/or on):
    ideal (hysteresis- and backlash-free) actuator and regulated supply, whose
    noise-free readings are ``w_{u_d}`` of Eq. 26.
 
+With ``adaptive=True`` each channel also gets issue 17's columns (b) the
+model augmented with what a diagnosis of the identification run found and
+(c) adaptive tracking (:mod:`hyst_id.experiment.columns`).
+
 No simulator truth enters identification, calibration or compensation; the
 truth is only used for the reference output and the true-vs-identified table.
 Tables and figures are in :mod:`hyst_id.experiment.report`.
@@ -43,7 +47,7 @@ from __future__ import annotations
 from dataclasses import replace
 import os
 import time
-from typing import Callable, Sequence
+from typing import Any, Callable, Sequence
 
 import numpy as np
 from scipy.optimize import least_squares
@@ -55,6 +59,7 @@ from hyst_id.experiment.result import (
     ChannelResult,
     CHANNELS,
     CLEAN_SERIES,
+    eps_c_percent,
     ExperimentConfig,
     ExperimentResult,
     MODES,
@@ -72,16 +77,6 @@ __all__ = ['run_experiment', 'fit_position_calibration',
            'to_position_units', 'to_backlash_gauge', 'eps_c_percent', 'ideal_actuator_params']
 
 
-def eps_c_percent(w_c: np.ndarray, w_ud: np.ndarray, offset: float = 0.0) -> float:
-    """Average percentage control error, Eq. 26, of signals measured from ``offset``.
-
-    ``offset`` is the reading at zero position (a calibration's ``b``): the
-    error is then relative to the position-equivalent signal (``k`` cancels).
-    """
-    w_c, w_ud = np.asarray(w_c, dtype=float), np.asarray(w_ud, dtype=float)
-    return float(np.sqrt(np.sum((w_c - w_ud) ** 2) / np.sum((w_ud - offset) ** 2)) * 100.0)
-
-
 def _lag(channel: str, theta: np.ndarray, position: np.ndarray, t_s: np.ndarray) -> np.ndarray:
     if channel == 'pressure':
         return simulate_first_order(position, t_s, theta[0])
@@ -89,7 +84,7 @@ def _lag(channel: str, theta: np.ndarray, position: np.ndarray, t_s: np.ndarray)
 
 
 def fit_position_calibration(channel: str, t_s: np.ndarray, position: np.ndarray,
-                             reading: np.ndarray) -> Calibration:
+                             reading: np.ndarray, gain_law: str = 'none') -> Calibration:
     """Fit ``reading = k F(position) + b`` on a run where both were recorded.
 
     ``F`` is ``1/(tau s + 1)`` for pressure and ``w^2/(s^2 + 2 zeta w s + w^2)``
@@ -98,12 +93,21 @@ def fit_position_calibration(channel: str, t_s: np.ndarray, position: np.ndarray
     ``F`` (variable projection), ``F``'s parameters bounded least squares
     from a few starts. Only measured data are used.
 
+    With ``gain_law`` ``'exponential'`` or ``'linear'`` (a diagnosed
+    ``supply_decay`` or ``gain_drift``) the fit is ``reading = g(t) (k F + b0)
+    + b1`` with ``g = exp(-rate t)`` or ``1 + rate t`` from the run's start,
+    and the calibration returned holds at the start: ``k, b = b0 + b1``, the
+    rate in ``dynamics['gain_rate_per_s']``. With ``'offset'`` (a diagnosed
+    ``offset_drift``) it is ``reading = k F + b + rate t``, linear in the rate.
+
     Parameters
     ----------
     channel : str
         ``position``, ``pressure`` or ``flow``.
     t_s, position, reading : numpy.ndarray
         Sample times, position readings (mA-eq) and the channel's readings.
+    gain_law : {'none', 'exponential', 'linear', 'offset'}
+        A gain (or an offset) changing over the run.
 
     Returns
     -------
@@ -118,8 +122,19 @@ def fit_position_calibration(channel: str, t_s: np.ndarray, position: np.ndarray
     y = np.asarray(reading, dtype=float)
     ones = np.ones_like(y)
 
+    n_dyn = 1 if channel == 'pressure' else 2
+    elapsed = t - t[0]
+
     def solve(theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        a = np.column_stack([_lag(channel, theta, pos, t), ones])
+        f = _lag(channel, theta[:n_dyn], pos, t)
+        if gain_law == 'none':
+            a = np.column_stack([f, ones])
+        elif gain_law == 'offset':
+            a = np.column_stack([f, ones, elapsed])
+        else:
+            r = theta[n_dyn]
+            g = np.exp(-r * elapsed) if gain_law == 'exponential' else 1.0 + r * elapsed
+            a = np.column_stack([g * f, g, ones])
         kb = np.linalg.lstsq(a, y, rcond=None)[0]
         return kb, y - a @ kb
 
@@ -128,16 +143,30 @@ def fit_position_calibration(channel: str, t_s: np.ndarray, position: np.ndarray
     else:
         starts = [[0.3, 0.5], [0.7, 1.5], [0.5, 5.0]]
         bounds = ([0.0, 0.01], [0.99, 10.0])
+    if gain_law not in ('none', 'exponential', 'linear', 'offset'):
+        raise ConfigError(f'unknown gain law {gain_law!r}')
+    if gain_law in ('exponential', 'linear'):
+        # rates of -1 .. +1 per run length (linear: the gain stays above 0)
+        span = max(float(elapsed[-1]), 1e-9)
+        lo = -1.0 / span if gain_law == 'exponential' else -0.99 / span
+        starts = [x0 + [0.0] for x0 in starts]
+        bounds = (bounds[0] + [lo], bounds[1] + [1.0 / span])
     best = None
     for x0 in starts:
         sol = least_squares(lambda th: solve(th)[1], x0, bounds=bounds, method='trf')
         if best is None or sol.cost < best.cost:
             best = sol
-    (k, b), res = solve(best.x)
+    coef, res = solve(best.x)
     names = ('tau_s',) if channel == 'pressure' else ('zeta', 'omega_n')
-    return Calibration(channel, float(k), float(b),
-                       {n: float(v) for n, v in zip(names, best.x)},
-                       float(np.sqrt(np.mean(res ** 2))))
+    dynamics = {n: float(v) for n, v in zip(names, best.x)}
+    if gain_law == 'offset':
+        k, b = float(coef[0]), float(coef[1])
+        dynamics.update(gain_law=gain_law, offset_rate_per_s=float(coef[2]))
+    else:
+        k, b = float(coef[0]), float(np.sum(coef[1:]))
+    if gain_law in ('exponential', 'linear'):
+        dynamics.update(gain_law=gain_law, gain_rate_per_s=float(best.x[n_dyn]))
+    return Calibration(channel, k, b, dynamics, float(np.sqrt(np.mean(res ** 2))))
 
 
 def to_position_units(x: np.ndarray, output_sign: float, cal: Calibration) -> np.ndarray:
@@ -251,6 +280,56 @@ def _channel_result(sc: ScenarioResult, mode: str, ident: Identification, rig: R
         top_line_reached=bool(v_reach >= loop_corners(x_pos[:8])['C'][0]))
 
 
+def _adaptive(sc: ScenarioResult, rig: RigParams, config: ExperimentConfig,
+              channels: Sequence[str], diagnose_settings: Any,
+              progress: Callable[[int, int, str], None] | None, total: int, key: str,
+              timings: dict) -> None:
+    """Columns (b) and (c) for every channel result of a scenario."""
+    from hyst_id.diagnosis import DiagnoseSettings
+    from hyst_id.experiment.columns import adaptive_columns, diagnose_channel
+
+    settings = diagnose_settings or DiagnoseSettings(max_mechanisms=3)
+    lo, hi = config.command_limits_ma
+    run = sc.ident_run
+    for ch in channels:
+        t0 = time.perf_counter()
+        diag = diagnose_channel(run.recording(ch), settings)
+        # a diagnosed drift in time: the position calibration with it, referred to the
+        # run's start (the supply level the regulated reference holds)
+        law = 'none'
+        for f in diag.findings:
+            corr = f.compensation.get('correction', {})
+            if law == 'none' and 'augment.gain_law' in corr:
+                law = corr['augment.gain_law']
+            elif law == 'none' and 'augment.offset_rate_per_s' in corr:
+                law = 'offset'
+        cal = sc.calibrations[ch] if law == 'none' or ch == 'position' else \
+            fit_position_calibration(ch, run.t_s, run.position, run.measurement(ch), law)
+        desired = cal.from_position(sc.uncompensated.command_ma)
+        for (mode, c), r in sc.channels.items():
+            if c == ch:
+                r.adaptive = adaptive_columns(
+                    diag, r, rig, sc.reference.t_s, sc.reference.truth[CLEAN_SERIES[ch]],
+                    sc.calibrations[ch].b, CommandLimits(lo, hi), config.comp_noise_seed,
+                    desired_augmented=desired)
+                r.adaptive.calibration = cal
+                r.adaptive.floor_percent = (_desired_floor(sc, ch, sc.calibrations[ch]),
+                                            _desired_floor(sc, ch, cal))
+        timings[f'{key} adaptive {ch}'] = time.perf_counter() - t0
+        if progress:
+            progress(1, total, f'{key} {ch}: diagnosis {diag.verdict}, augmented and tracking')
+
+
+def _desired_floor(sc: ScenarioResult, ch: str, cal: Calibration) -> float:
+    """%ε_c of a perfect compensator: the desired value through the calibration's lag."""
+    t = sc.reference.t_s
+    desired = cal.from_position(sc.uncompensated.command_ma)
+    names = {'pressure': ('tau_s',), 'flow': ('zeta', 'omega_n')}.get(ch)
+    w = desired if names is None else _lag(ch, np.array([cal.dynamics[n] for n in names]),
+                                           desired, t)
+    return eps_c_percent(w, sc.reference.truth[CLEAN_SERIES[ch]], sc.calibrations[ch].b)
+
+
 def _settings_for(settings: IdentifySettings, mode: str) -> IdentifySettings:
     return replace(settings, refine=(mode == 'refined'))
 
@@ -259,7 +338,8 @@ def run_experiment(params_path=None, *, settings: IdentifySettings | None = None
                    seeds: int | Sequence[int] | None = None,
                    regulation: Sequence[bool] = (False,), modes: Sequence[str] = MODES,
                    channels: Sequence[str] = CHANNELS, config: ExperimentConfig | None = None,
-                   progress: Callable[[int, int, str], None] | None = None
+                   progress: Callable[[int, int, str], None] | None = None,
+                   adaptive: bool = False, diagnose_settings: Any = None
                    ) -> ExperimentResult:
     """Reproduce section 4: identification from three sensors, Table 1, compensation.
 
@@ -280,7 +360,12 @@ def run_experiment(params_path=None, *, settings: IdentifySettings | None = None
     config : ExperimentConfig, optional
         Run lengths, sampling, noise seeds, command limits.
     progress : callable, optional
-        ``progress(advance, total, message)`` after every GAASS seed.
+        ``progress(advance, total, message)`` after every GAASS seed (and every
+        channel's diagnosis with ``adaptive``).
+    adaptive : bool
+        Also run columns (b) augmented and (c) tracking (issue 17).
+    diagnose_settings : DiagnoseSettings, optional
+        For (b)'s diagnosis (default: ``DiagnoseSettings(max_mechanisms=3)``).
 
     Returns
     -------
@@ -297,7 +382,7 @@ def run_experiment(params_path=None, *, settings: IdentifySettings | None = None
     base = as_rig_params(params_path)
     source = (str(params_path) if isinstance(params_path, (str, os.PathLike))
               else 'defaults' if params_path is None else type(params_path).__name__)
-    total = len(regulation) * len(modes) * len(channels) * len(settings.seeds)
+    total = len(regulation) * (len(modes) * len(settings.seeds) + int(adaptive)) * len(channels)
     timings: dict[str, float] = {}
     t_start = time.perf_counter()
     t_id = np.arange(0.0, config.ident_duration_s, config.ident_dt_s)
@@ -343,6 +428,9 @@ def run_experiment(params_path=None, *, settings: IdentifySettings | None = None
                 ident = cache[digest]
                 sc.channels[(mode, ch)] = _channel_result(sc, mode, ident, rig, config, u_d)
                 timings[label] = time.perf_counter() - t0
+        if adaptive:
+            _adaptive(sc, rig, config, channels, diagnose_settings, progress, total, key,
+                      timings)
         scenarios[key] = sc
     timings['total'] = time.perf_counter() - t_start
     return ExperimentResult(params_source=source, rig=base, config=config, settings=settings,

@@ -24,8 +24,9 @@ import numpy as np
 import pytest
 
 from hyst_id.cli import main
-from hyst_id.commands.experiment import QUICK_SETTINGS
+from hyst_id.commands.experiment import QUICK_DIAGNOSIS, QUICK_SETTINGS
 from hyst_id.compensation import CommandLimits, Compensator, InverseModel
+from hyst_id.errors import ConfigError
 from hyst_id.experiment.report import format_markdown, headline, PAPER, write_outputs
 from hyst_id.experiment.result import Calibration, CHANNELS, MODES
 from hyst_id.experiment.run import (
@@ -89,6 +90,31 @@ def test_calibration_recovers_gain_offset_and_lag():
     assert fit_position_calibration('position', t, position, position).k == 1.0
 
 
+@pytest.mark.parametrize('law', ['exponential', 'linear', 'offset'])
+def test_calibration_with_a_drift_holds_at_the_run_start(law):
+    """(b)'s calibration: the drift fitted with it, the start's k and b returned."""
+    t, v = _t_v()
+    position = chain_spec('position', calibration=(1.0, 0.0)).simulate(RIG_X, t, v)
+    s = simulate_first_order(position, t, 1.4)
+    el = t - t[0]
+    if law == 'offset':
+        reading = -5.0e4 * s + 7.5e5 - 300.0 * el
+    else:
+        g = np.exp(-0.004 * el) if law == 'exponential' else 1.0 - 0.003 * el
+        reading = g * (-5.0e4 * s + 2.0e5) + 5.5e5
+    reading = reading + np.random.default_rng(4).normal(0.0, 300.0, t.size)
+    cal = fit_position_calibration('pressure', t, position, reading, gain_law=law)
+    assert cal.k == pytest.approx(-5.0e4, rel=3e-3) and cal.b == pytest.approx(7.5e5, rel=1e-3)
+    assert cal.dynamics['tau_s'] == pytest.approx(1.4, rel=2e-2)
+    rate = {'offset': ('offset_rate_per_s', -300.0), 'exponential': ('gain_rate_per_s', 0.004),
+            'linear': ('gain_rate_per_s', -0.003)}[law]
+    assert cal.dynamics[rate[0]] == pytest.approx(rate[1], rel=3e-2)
+    plain = fit_position_calibration('pressure', t, position, reading)
+    assert abs(plain.b - 7.5e5) > 10 * abs(cal.b - 7.5e5)     # the average, not the start
+    with pytest.raises(ConfigError, match='gain law'):
+        fit_position_calibration('pressure', t, position, reading, gain_law='cubic')
+
+
 def test_ideal_actuator_follows_the_command_with_regulated_supply():
     rig = ideal_actuator_params(load_rig_params(PARAMS))
     assert rig.supply.regulation
@@ -110,7 +136,27 @@ def test_eps_c_is_eq26_measured_from_an_offset():
 @pytest.fixture(scope='module')
 def quick():
     settings = replace(QUICK_SETTINGS, workers=2)
-    return run_experiment(PARAMS, settings=settings, seeds=1, regulation=(False,))
+    return run_experiment(PARAMS, settings=settings, seeds=1, regulation=(False,),
+                          adaptive=True, diagnose_settings=QUICK_DIAGNOSIS)
+
+
+def test_quick_run_has_the_augmented_and_tracking_columns(quick):
+    """Issue 17's (b) and (c) for every channel, with what the diagnosis became."""
+    sc = quick.scenarios['off']
+    for (mode, ch), r in sc.channels.items():
+        a = r.adaptive
+        assert a is not None and a.augmented_from in ('diagnosis', 'identification')
+        assert np.isfinite(a.eps_c_augmented_percent) and np.isfinite(a.eps_c_tracking_percent)
+        assert all(h.startswith(('in-line', 'no in-line', 'not applied'))
+                   for _, h in a.applied)
+        assert np.all((a.command_augmented_ma >= 4.0) & (a.command_augmented_ma <= 20.0))
+        # nothing is worse than no compensation at all (measured: see docs/RESULTS.md)
+        assert a.eps_c_augmented_percent < sc.eps_unc_percent[ch], (mode, ch)
+    text = format_markdown(quick)
+    assert '(b) augmented' in text and '(c) tracking' in text
+    doc = json.loads(json.dumps(quick.to_dict()))
+    assert doc['scenarios']['off']['results']['refined']['pressure']['adaptive'][
+        'augmented_from'] in ('diagnosis', 'identification')
 
 
 def test_quick_run_compensation_beats_no_compensation_on_every_channel(quick):
@@ -163,11 +209,12 @@ def test_cli_gaass_only_quick(tmp_path, capsys):
     out = tmp_path / 'exp'
     figs = tmp_path / 'figs'
     code = main(['experiment', '--params', str(PARAMS), '--out', str(out), '--quick',
-                 '--gaass-only', '--seeds', '1', '--no-fig2', '--quiet',
+                 '--gaass-only', '--seeds', '1', '--no-fig2', '--quiet', '--no-adaptive',
                  '--copy-figures', str(figs)])
     assert code == 0
     assert (out / 'results.json').is_file() and (figs / 'fig6_pressure.png').is_file()
-    assert 'GAASS only' in capsys.readouterr().out
+    out_text = capsys.readouterr().out
+    assert 'GAASS only' in out_text and '(b) augmented' not in out_text
 
 
 @pytest.mark.slow
