@@ -1,0 +1,65 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""How the diagnosis of the paper rig's identification run moves with round-off (issue 17).
+
+The unregulated paper rig's Eq. 24 identification run (what ``hyst-id
+experiment`` column (b) diagnoses) is diagnosed once per round-off probe
+(``HYST_ID_ROUNDOFF_PROBE``: 0 = none, 1-3 perturb the recording's last
+bits as another CPU's sums would); each line prints the verdict, the
+findings and the final held-out %e_r. A verdict that changes between
+probes is a tie the data do not decide.
+
+Usage: ``python bench/rig_diagnosis_roundoff.py [--channel pressure] [--probes 0 1 2 3]``
+(about a minute per probe).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import subprocess
+import sys
+
+ONE = """
+import numpy as np
+from hyst_id.diagnosis import diagnose, DiagnoseSettings
+from hyst_id.rig import as_rig_params, simulate_rig
+from hyst_id.signals.excitation import eq24
+rig = as_rig_params('params/paper_rig.yaml').with_values({'supply.regulation': False})
+t = np.arange(0.0, 100.0, 0.05)
+run = simulate_rig(rig, t, eq24(t), seed=0)
+d = diagnose(run.recording(%r), settings=DiagnoseSettings(max_mechanisms=3))
+print(d.verdict, [f.mechanism for f in d.findings], round(d.final.er_holdout_percent, 4),
+      [[a['mechanism'] for a in f.alternatives] for f in d.findings])
+"""
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument('--channel', default='pressure', choices=('position', 'pressure', 'flow'))
+    ap.add_argument('--probes', type=int, nargs='+', default=[0, 1, 2, 3])
+    args = ap.parse_args()
+    for probe in args.probes:
+        env = dict(os.environ, HYST_ID_ROUNDOFF_PROBE=str(probe))
+        if probe == 0:
+            env.pop('HYST_ID_ROUNDOFF_PROBE')
+        out = subprocess.run([sys.executable, '-c', ONE % args.channel], env=env,
+                             capture_output=True, text=True, check=False)
+        line = out.stdout.strip().splitlines()[-1] if out.stdout.strip() else out.stderr[-300:]
+        print(f'probe {probe}: {line}', flush=True)
+
+
+if __name__ == '__main__':
+    main()
