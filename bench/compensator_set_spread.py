@@ -14,7 +14,7 @@
 
 """Spread behind ``test/diagnosis/test_compensator_set.py``'s bounds (issue 17).
 
-For each seed: a decaying-gain, a dead-time and a clean recording from the
+For each seed: a decaying-gain, a dead-time, a bent (static curve) and a clean recording from the
 independent reference simulator are diagnosed, the compensator set is
 exported and a fresh run of the same plant compensated with and without the
 in-line corrections. Prints the rms error of the reading against the
@@ -27,6 +27,7 @@ Usage: ``PYTHONPATH=.:test python bench/compensator_set_spread.py [--seeds 4]``
 from __future__ import annotations
 
 import argparse
+from dataclasses import replace
 from pathlib import Path
 import sys
 
@@ -59,6 +60,12 @@ def main() -> None:
         print(f'| dead time 0.5 s | {seed} | {d.verdict} | {a.dead_time_s:.4f} s | '
               f'{t._rms_error(m, Augmentation(), delay_s=0.5):.3f} | '
               f'{t._rms_error(m, a, delay_s=0.5):.3f} |', flush=True)
+        d = diagnose(t._recording(seed, curve=True), settings=t.SETTINGS)
+        m, a, _ = compensator_set(d)
+        straight = replace(a, poly_c2=0.0, poly_c3=0.0)
+        print(f'| static curve | {seed} | {d.verdict} | {a.describe()} | '
+              f'{t._rms_error(m, straight, curve=True):.3f} (straight part of the curve) | '
+              f'{t._rms_error(m, a, curve=True):.3f} |', flush=True)
         d = diagnose(t._recording(seed + 4), settings=t.SETTINGS)
         m, a, _ = compensator_set(d)
         print(f'| clean | {seed + 4} | {d.verdict} | {a.describe()} | - | '

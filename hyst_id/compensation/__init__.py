@@ -21,7 +21,7 @@ model state, atomic swaps). :mod:`.tracking` wraps it in an
 plant's slow gain and offset from its measurement; :mod:`.augment` wraps it
 in an :class:`~hyst_id.compensation.augment.AugmentedCompensator` that runs
 a diagnosis's in-line corrections (dead time ahead, gain and offset
-schedules, travel stops).
+schedules, travel stops, a static curve's inverse).
 
 May import: :mod:`hyst_id.models`, :mod:`hyst_id.errors`.
 """

@@ -38,6 +38,12 @@ units and seconds:
   the gain never falls below :data:`MIN_GAIN`.
 * command limits (``saturation``): ``min_command``/``max_command`` at the
   stops.
+* an output map (``static_nonlinearity``): the reading is the cubic
+  ``poly_c0 + poly_c1 z + poly_c2 z^2 + poly_c3 z^3`` of the model's output
+  ``z`` (the diagnosis's travel normalised to [-1, 1] over the record: only
+  with the diagnosis's own set, :func:`hyst_id.diagnosis.export.compensator_set`);
+  the desired value is mapped back through its inverse (monotone over
+  ``|z| <= POLY_RANGE`` or refused).
 
 What has no in-line correction stays in the plant and the diagnosis report
 says so (``compensation.how``); the compensator's tracking
@@ -68,6 +74,9 @@ AUGMENT_PREFIX = 'augment.'
 GAIN_LAWS = ('none', 'exponential', 'linear')
 #: The scheduled gain is never taken below this share of its reference.
 MIN_GAIN = 0.05
+#: The output map is inverted over ``|z| <= POLY_RANGE`` (the record's travel is [-1, 1]).
+POLY_RANGE = 1.25
+_IDENTITY_POLY = (0.0, 1.0, 0.0, 0.0)
 
 
 @dataclass(frozen=True)
@@ -85,6 +94,10 @@ class Augmentation:
     schedule_horizon_s: float = 0.0
     min_command: float = -math.inf
     max_command: float = math.inf
+    poly_c0: float = 0.0
+    poly_c1: float = 1.0
+    poly_c2: float = 0.0
+    poly_c3: float = 0.0
 
     def __post_init__(self) -> None:
         if self.gain_law not in GAIN_LAWS:
@@ -103,6 +116,52 @@ class Augmentation:
             raise InvalidParametersError('augment.gain_reference must be > 0')
         if not self.min_command < self.max_command:
             raise InvalidParametersError('augment.min_command must be < augment.max_command')
+        if self.has_output_map:
+            c = self.poly
+            if not all(math.isfinite(x) for x in c):
+                raise InvalidParametersError('augment.poly_c0..c3 must be finite')
+            z = np.linspace(-POLY_RANGE, POLY_RANGE, 101)
+            slope = c[1] + 2.0 * c[2] * z + 3.0 * c[3] * z * z
+            if not (np.all(slope > 0) or np.all(slope < 0)):
+                raise InvalidParametersError(
+                    'augment.poly_c0..c3: the output map is not monotone over |z| <= '
+                    f'{POLY_RANGE}, so it has no inverse there')
+
+    @property
+    def poly(self) -> tuple[float, float, float, float]:
+        """The output map's coefficients ``(c0, c1, c2, c3)``."""
+        return (self.poly_c0, self.poly_c1, self.poly_c2, self.poly_c3)
+
+    @property
+    def has_output_map(self) -> bool:
+        """Whether the output map is other than the identity."""
+        return self.poly != _IDENTITY_POLY
+
+    def invert_output_map(self, reading: float) -> float:
+        """The model output ``z`` whose mapped reading is ``reading`` (clipped to the range)."""
+        c0, c1, c2, c3 = self.poly
+        if not self.has_output_map:
+            return reading
+
+        def p(z: float) -> float:
+            return c0 + z * (c1 + z * (c2 + z * c3))
+
+        lo, hi = -POLY_RANGE, POLY_RANGE
+        p_lo, p_hi = p(lo), p(hi)
+        rising = p_hi > p_lo
+        if (reading <= p_lo) == rising:
+            return lo
+        if (reading >= p_hi) == rising:
+            return hi
+        for _ in range(60):                    # bisection: monotone, always converges
+            mid = 0.5 * (lo + hi)
+            if (p(mid) < reading) == rising:
+                lo = mid
+            else:
+                hi = mid
+            if hi - lo < 1e-13:
+                break
+        return 0.5 * (lo + hi)
 
     @property
     def active(self) -> bool:
@@ -164,6 +223,9 @@ class Augmentation:
             parts.append(f'schedules held after {self.schedule_horizon_s:.4g} s')
         if math.isfinite(self.min_command) or math.isfinite(self.max_command):
             parts.append(f'stops [{self.min_command:.4g}, {self.max_command:.4g}]')
+        if self.has_output_map:
+            parts.append('output map ' + ' '.join(f'{c:+.4g}{t}' for c, t in zip(
+                self.poly, ('', ' z', ' z^2', ' z^3'))))
         return ', '.join(parts) or 'none'
 
     def limits(self, base: CommandLimits) -> CommandLimits:
@@ -191,10 +253,15 @@ class Augmentation:
             return 0.0
         return self.offset_rate_per_s * (self._held(elapsed_s) - self.offset_reference_s)
 
-    def model_target(self, desired: float, elapsed_s: float) -> float:
-        """What the model must output so that the reading is ``desired`` at ``elapsed_s``."""
-        c = self.gain_centre
-        return (desired - c - self.offset(elapsed_s)) / self.gain(elapsed_s) + c
+    def model_target(self, desired: float, elapsed_s: float | None) -> float:
+        """What the model must output so that the reading is ``desired`` at ``elapsed_s``.
+
+        Without a time (``None``) only the output map is undone.
+        """
+        if elapsed_s is not None:
+            c = self.gain_centre
+            desired = (desired - c - self.offset(elapsed_s)) / self.gain(elapsed_s) + c
+        return self.invert_output_map(desired)
 
     def _held(self, elapsed_s: float) -> float:
         t = max(float(elapsed_s), 0.0)
@@ -294,9 +361,8 @@ class AugmentedCompensator:
         if t_s is not None and self._t0 is None:
             self._t0 = float(t_s)
         target = self.predicted_desired(float(desired), t_s)
-        if t_s is not None:
-            target = aug.model_target(target, t_s - self._t0 + aug.dead_time_s)
-        return self.inner.step(target, t_s)
+        elapsed = None if t_s is None else t_s - self._t0 + aug.dead_time_s
+        return self.inner.step(aug.model_target(target, elapsed), t_s)
 
     def run(self, desired: np.ndarray, t_s: np.ndarray | None = None) -> np.ndarray:
         """Commands for a whole desired sequence."""
@@ -308,7 +374,8 @@ class AugmentedCompensator:
         return out
 
 
-def augmentation_from_findings(findings: Iterable[Any], record_duration_s: float
+def augmentation_from_findings(findings: Iterable[Any], record_duration_s: float,
+                               model_from: str = 'identification'
                                ) -> tuple[Augmentation, list[tuple[str, str]]]:
     """The corrections of a diagnosis's accepted findings, and what each one became.
 
@@ -319,6 +386,10 @@ def augmentation_from_findings(findings: Iterable[Any], record_duration_s: float
         each ``compensation['correction']`` holds ``augment.*`` values.
     record_duration_s : float
         Length of the diagnosed record: the schedules are held beyond it.
+    model_from : {'identification', 'diagnosis'}
+        Whose H and B the compensator runs: an output map (``poly_*``) is
+        written in the diagnosis's own travel units, so it is applied only
+        with the diagnosis's set.
 
     Returns
     -------
@@ -334,6 +405,11 @@ def augmentation_from_findings(findings: Iterable[Any], record_duration_s: float
         if not corr:
             applied.append((d['mechanism'], 'no in-line correction: '
                             + str((d.get('compensation') or {}).get('how', ''))))
+            continue
+        if model_from != 'diagnosis' and any(k.startswith(AUGMENT_PREFIX + 'poly_')
+                                             for k in corr):
+            applied.append((d['mechanism'], "not applied: its output map needs the diagnosis's "
+                            'own set (hyst-id diagnose --params-out)'))
             continue
         clash = sorted(set(corr) & set(values))
         if clash:

@@ -22,9 +22,11 @@ written in the recording's command units and the canonical gauge
 (:mod:`hyst_id.identification.gauge`) with the calibration at the record's
 start, which is what :class:`hyst_id.compensation.InverseModel` holds.
 
-Only the paper's ``tk`` family is mapped out of the diagnosis's normalised
-command frame; a chain with a quantity-stage block (a static nonlinearity)
-has no linear calibration to fold into H. Both raise
+A static nonlinearity is a cubic of the travel normalised to [-1, 1] over the
+record (``z``): H and B are then written with ``z`` as their output, and the
+cubic goes into the augmentation as its output map. Only the paper's ``tk``
+family is mapped out of the diagnosis's normalised command frame; another
+family there, or another quantity-stage block, raises
 :class:`~hyst_id.errors.InvalidParametersError` and the caller keeps an
 identified set with :func:`hyst_id.compensation.augment.augmentation_from_findings`.
 """
@@ -80,9 +82,10 @@ def compensator_set(d: Diagnosis) -> tuple[InverseModel, Augmentation, list[tupl
     model = fit.model
     if model is None:
         raise InvalidParametersError('the diagnosis holds no fitted model')
-    if any(m.stage == 'quantity' for m in model.mechanisms):
-        raise InvalidParametersError('a static nonlinearity has no linear calibration to '
-                                     'fold into H')
+    quantity = [m.id for m in model.mechanisms if m.stage == 'quantity']
+    if quantity and quantity != ['static_nonlinearity']:
+        raise InvalidParametersError(f'{", ".join(quantity)} cannot be written as an output '
+                                     'map of the compensator')
     fam = model.spec.family
     nh = fam.n_params
     x = np.asarray(fit.p[:nh + 3], dtype=float)
@@ -92,11 +95,19 @@ def compensator_set(d: Diagnosis) -> tuple[InverseModel, Augmentation, list[tupl
             raise InvalidParametersError(f'family {fam.id!r} cannot be mapped out of the '
                                          "diagnosis's normalised command")
         x = tk_in_command_units(x, scale)
-    k = float(fit.coef[fit.labels.index('sensor')])
-    if not np.isfinite(k) or k == 0.0:
-        raise InvalidParametersError('the final model has no calibration gain')
-    calibration = (k, float(fit.offset_at_start))
+    if quantity:               # H and B output the normalised travel z
+        lo, hi = fit.span
+        calibration = (2.0 / (hi - lo), -(hi + lo) / (hi - lo))
+    else:
+        k = float(fit.coef[fit.labels.index('sensor')])
+        if not np.isfinite(k) or k == 0.0:
+            raise InvalidParametersError('the final model has no calibration gain')
+        calibration = (k, float(fit.offset_at_start))
     canon = canonical_gauge(x, calibration, fam)
     inverse = InverseModel.from_vector(canon, output_sign(calibration), fam.id)
-    aug, applied = augmentation_from_findings(d.findings, float(d.t_s[-1] - d.t_s[0]))
+    aug, applied = augmentation_from_findings(d.findings, float(d.t_s[-1] - d.t_s[0]),
+                                              model_from='diagnosis')
+    if quantity and not aug.has_output_map:
+        raise InvalidParametersError('the fitted static curve is not monotone over the '
+                                     'travel: no inverse')
     return inverse, replace(aug, gain_reference=1.0, offset_reference_s=0.0), applied

@@ -189,3 +189,35 @@ def test_findings_become_corrections_once_each():
                                schedule_horizon_s=200.0)
     assert [a[1].split(':')[0] for a in applied] == [
         'in-line', 'no in-line correction', 'not applied', 'in-line']
+
+
+POLY = (470.0, 45.0, 8.0, 4.0)          # reading = cubic of z = (linear reading - 470) / 45
+
+
+def test_an_output_map_is_inverted():
+    aug = Augmentation(poly_c0=POLY[0], poly_c1=POLY[1], poly_c2=POLY[2], poly_c3=POLY[3])
+
+    def curved(cmds):
+        z = (_reading(cmds) - 470.0) / 45.0
+        return POLY[0] + z * (POLY[1] + z * (POLY[2] + z * POLY[3]))
+
+    z_cal = (K / 45.0, (B0 - 470.0) / 45.0)                 # H and B output z
+    z_model = InverseModel.from_vector(canonical_gauge(np.r_[H, B], z_cal))
+    mapped = AugmentedCompensator(z_model, aug, CommandLimits(4.0, 20.0), v0=9.0)
+    straight = _rms(curved(_commands(None)) - DESIRED)
+    inverted = _rms(curved(mapped.run(DESIRED, T)) - DESIRED)
+    assert straight > 3.0 and inverted < 1e-6 * straight, (straight, inverted)
+    for d in (430.0, 470.0, 512.5):
+        z = aug.invert_output_map(d)
+        assert POLY[0] + z * (POLY[1] + z * (POLY[2] + z * POLY[3])) == pytest.approx(d)
+    assert aug.invert_output_map(1e6) == 1.25 and aug.invert_output_map(-1e6) == -1.25
+    assert 'output map' in aug.describe()
+
+
+def test_a_map_that_folds_back_is_refused():
+    with pytest.raises(InvalidParametersError, match='not monotone'):
+        Augmentation(poly_c1=1.0, poly_c3=-1.0)      # slope 1 - 3 z^2 changes sign
+    _, applied = augmentation_from_findings([{'mechanism': 'static_nonlinearity',
+                                              'compensation': {'correction': {
+                                                  'augment.poly_c2': 0.1}}}], 10.0)
+    assert applied[0][1].startswith("not applied: its output map needs the diagnosis's")

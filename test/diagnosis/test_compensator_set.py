@@ -23,6 +23,8 @@ compensated with and without the corrections.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 from reference_sim import backlash, hysteresis
@@ -45,10 +47,19 @@ T = np.arange(2400) * 0.05
 DESIRED = 460.0 + 30.0 * np.sin(2 * np.pi * T / 9.0) * (0.6 + 0.4 * np.sin(2 * np.pi * T / 37.0))
 
 
-def _plant(v: np.ndarray, delay_s: float = 0.0, rate: float = 0.0) -> np.ndarray:
-    """Noise-free reading: ``100 + exp(-rate t) 40 B(H(v(t - delay)))`` (reference code)."""
+def _plant(v: np.ndarray, delay_s: float = 0.0, rate: float = 0.0, curve: bool = False
+           ) -> np.ndarray:
+    """Noise-free reading: ``100 + exp(-rate t) 40 B(H(v(t - delay)))`` (reference code).
+
+    With ``curve`` the reading is bent: ``450 + 150 (z + 0.25 z^2 + 0.1 z^3)`` of
+    ``z = (straight reading - 450) / 150`` (monotone everywhere).
+    """
     v = np.interp(T - delay_s, T, v) if delay_s else v
-    return 100.0 + np.exp(-rate * T) * 40.0 * backlash(hysteresis(v, *H), *B)
+    y = 100.0 + np.exp(-rate * T) * 40.0 * backlash(hysteresis(v, *H), *B)
+    if curve:
+        z = (y - 450.0) / 150.0
+        y = 450.0 + 150.0 * (z + 0.25 * z * z + 0.1 * z ** 3)
+    return y
 
 
 def _recording(seed: int, **effect) -> Recording:
@@ -92,6 +103,19 @@ def test_a_dead_time_is_predicted_ahead(seed):
     # measured (seeds 0-3): without 4.84-4.87, ahead 0.97-0.99 (0.20 x: the slope
     # extrapolated over the delay misses the curvature)
     assert ahead < 0.3 * without, (without, ahead)
+
+
+@pytest.mark.parametrize('seed', [0, 1])
+def test_a_static_curve_is_inverted_with_the_diagnosis_set(seed):
+    d = diagnose(_recording(seed, curve=True), settings=SETTINGS)
+    assert d.verdict == 'static_nonlinearity', [f.mechanism for f in d.findings]
+    model, aug, applied = compensator_set(d)
+    assert aug.has_output_map and applied[0][1].startswith('in-line')
+    straight = replace(aug, poly_c2=0.0, poly_c3=0.0)     # the curve's straight part only
+    without = _rms_error(model, straight, curve=True)
+    inverted = _rms_error(model, aug, curve=True)
+    # measured (seeds 0-1): straight part 3.60-3.63, inverted 0.04-0.08 (0.01-0.02 x)
+    assert inverted < 0.1 * without, (without, inverted)
 
 
 def test_a_clean_recording_gives_the_plain_set_in_command_units():

@@ -42,7 +42,7 @@ class StaticNonlinearity(Mechanism):
     id = 'static_nonlinearity'  # noqa: A003
     title = 'nonlinear map from position to the sensed quantity'
     stage = 'quantity'
-    compensation = 'not in-line'
+    compensation = 'in-line'
     placement = 'between the actuator position and the sensor dynamics'
     physics = ('the sensed quantity is not proportional to the actuator position (valve '
                'characteristic, pneumatic pressure/flow map, nonlinear transducer)')
@@ -105,10 +105,31 @@ class StaticNonlinearity(Mechanism):
                                           for b in lv if b['flagged']]}
 
     def compensation_note(self, values, ctx) -> str:
-        """No inverse of the static curve in the compensator yet."""
-        return ('not compensated in-line yet: the compensator has no inverse of a static '
-                'curve between position and the measured quantity; the smooth H family '
-                '(--model auto) absorbs part of a curved characteristic')
+        """Inverted in-line with the diagnosis's own set."""
+        return ("in-line with the diagnosis's own set (hyst-id diagnose --params-out, "
+                'augment.poly_c0..c3): the compensator maps the desired value back through '
+                'the inverse of the fitted curve (monotone over the travel, or refused) before '
+                'B and H; with a set from hyst-id identify it is not applied (the curve is '
+                "written in the diagnosis's travel units)")
+
+    def correction(self, theta, coef, info, ctx) -> dict[str, float | str]:
+        """The curve as a cubic of the travel normalised to [-1, 1] (``z``), at the start.
+
+        ``y = c0 + c1 z + c2 z^2 + c3 z^3``: ``c1..c3`` are the fitted basis
+        coefficients and ``c0`` the reading at ``z = 0`` (the calibration's
+        offset at the record's start). An empty dict when the curve is not
+        monotone over the travel (no inverse).
+        """
+        labels, c = info['labels'], info['coef']
+        lo, hi = info['span']
+        c0 = float(info['to_meas'](np.array([0.5 * (lo + hi)]))[0])
+        out = {'augment.poly_c0': c0, 'augment.poly_c1': float(c[labels.index('sensor')]),
+               'augment.poly_c2': float(c[labels.index('quantity:1')]),
+               'augment.poly_c3': float(c[labels.index('quantity:2')])}
+        z = np.linspace(-1.25, 1.25, 101)
+        slope = out['augment.poly_c1'] + 2 * out['augment.poly_c2'] * z \
+            + 3 * out['augment.poly_c3'] * z * z
+        return out if (np.all(slope > 0) or np.all(slope < 0)) else {}
 
 
 MECHANISM = StaticNonlinearity()

@@ -58,6 +58,10 @@ AUGMENT_PARAMS = [
           'stay above it; .nan = none', unit='mA'),
     Param('augment.max_command', _NAN, 'high travel stop (diagnosis saturation): commands '
           'stay below it; .nan = none', unit='mA'),
+    *[Param(f'augment.poly_c{i}', 1.0 if i == 1 else 0.0,
+            f'output map (diagnosis static_nonlinearity): coefficient of z^{i} of the reading '
+            "as a cubic of the set's output z; identity 0, 1, 0, 0", unit='out')
+      for i in range(4)],
 ]
 
 
