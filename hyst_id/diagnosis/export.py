@@ -24,9 +24,10 @@ start, which is what :class:`hyst_id.compensation.InverseModel` holds.
 
 A static nonlinearity is a cubic of the travel normalised to [-1, 1] over the
 record (``z``): H and B are then written with ``z`` as their output, and the
-cubic goes into the augmentation as its output map. Only the paper's ``tk``
-family is mapped out of the diagnosis's normalised command frame; another
-family there, or another quantity-stage block, raises
+cubic goes into the augmentation as its output map. Each family maps its set
+out of the diagnosis's normalised command frame
+(:meth:`~hyst_id.models.family.HysteresisFamily.map_input`); a family without
+that map, or another quantity-stage block, raises
 :class:`~hyst_id.errors.InvalidParametersError` and the caller keeps an
 identified set with :func:`hyst_id.compensation.augment.augmentation_from_findings`.
 """
@@ -43,22 +44,7 @@ from hyst_id.diagnosis.result import Diagnosis
 from hyst_id.errors import InvalidParametersError
 from hyst_id.identification.gauge import canonical_gauge, output_sign
 
-__all__ = ['compensator_set', 'tk_in_command_units']
-
-
-def tk_in_command_units(params: np.ndarray, scale: tuple[float, float]) -> np.ndarray:
-    """The paper's loop written for ``v = a v_m + b`` instead of ``v_m``.
-
-    Side lines ``u = m (v_m - c)`` keep their slope per model unit divided by
-    ``a`` and cross at ``a c + b``; flat lines ``u = m v_m + c`` move their
-    intercept by ``-m b / a``.
-    """
-    a, b = float(scale[0]), float(scale[1])
-    p = np.array(params, dtype=float)
-    m_l, m_r, m_t, m_b, c_l, c_r, c_t, c_b = p[:8]
-    p[:8] = (m_l / a, m_r / a, m_t / a, m_b / a, a * c_l + b, a * c_r + b,
-             c_t - m_t * b / a, c_b - m_b * b / a)
-    return p
+__all__ = ['compensator_set']
 
 
 def compensator_set(d: Diagnosis) -> tuple[InverseModel, Augmentation, list[tuple[str, str]]]:
@@ -91,10 +77,11 @@ def compensator_set(d: Diagnosis) -> tuple[InverseModel, Augmentation, list[tupl
     x = np.asarray(fit.p[:nh + 3], dtype=float)
     scale = tuple(d.extra.get('command_scale', (1.0, 0.0)))
     if scale != (1.0, 0.0):
-        if fam.id != 'tk':
+        try:
+            x[:nh] = fam.map_input(x[:nh], float(scale[0]), float(scale[1]))
+        except NotImplementedError:
             raise InvalidParametersError(f'family {fam.id!r} cannot be mapped out of the '
-                                         "diagnosis's normalised command")
-        x = tk_in_command_units(x, scale)
+                                         "diagnosis's normalised command") from None
     if quantity:               # H and B output the normalised travel z
         lo, hi = fit.span
         calibration = (2.0 / (hi - lo), -(hi + lo) / (hi - lo))

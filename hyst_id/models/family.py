@@ -196,6 +196,14 @@ class HysteresisFamily:
         """Parameters whose H output is ``alpha * H(v) + delta`` (``alpha > 0``)."""
         raise NotImplementedError
 
+    def map_input(self, params: np.ndarray, a: float, b: float) -> np.ndarray:
+        """Parameters of the same loop driven by ``v = a v_m + b`` instead of ``v_m`` (``a > 0``).
+
+        ``H'(a v_m + b) == H(v_m)`` for every command sequence: what writes a set
+        found on a normalised command in the recording's own command units.
+        """
+        raise NotImplementedError
+
     # ------------------------------------------------------ domains, starts
     def domains(self, box: LoopBox) -> dict[str, tuple[float, float]]:
         """Search domain of every parameter for a loop living in ``box``."""

@@ -296,6 +296,16 @@ class Smooth(HysteresisFamily):
         p[_CO] = alpha * p[_CO] + delta
         return p
 
+    def map_input(self, params: np.ndarray, a: float, b: float) -> np.ndarray:
+        """Command-unit parameters scale with ``a`` (``r_max, v_s``; ``v_c -> a v_c + b``),
+        weights per command unit with ``1 / a``; a play is positively homogeneous."""
+        p = np.array(params, dtype=np.float64)
+        p[:_WL + 1] /= a
+        p[_RMAX] *= a
+        p[_VS] *= a
+        p[_VC] = a * p[_VC] + b
+        return p
+
     def domains(self, box: LoopBox) -> dict[str, tuple[float, float]]:
         """Weights to the steepest slope, thresholds to the span, saturation 0.01-20 spans."""
         span_v = max(box.span_v, 1e-12)
