@@ -40,6 +40,8 @@ sys.path.insert(0, str(ROOT))
 from real_recordings import load_all  # noqa: E402, I100
 
 from hyst_id.diagnosis import diagnose  # noqa: E402, I100
+from hyst_id.diagnosis.export import compensator_set  # noqa: E402
+from hyst_id.errors import HystIdError  # noqa: E402
 
 
 def _params(finding) -> str:
@@ -64,6 +66,11 @@ def main() -> int:
         for f in d.findings:
             print(f'  {f.mechanism}: {_params(f)} (held-out {f.er_holdout_before_percent:.3g} '
                   f'-> {f.er_holdout_after_percent:.3g})')
+        try:
+            model, aug, _ = compensator_set(d)
+            print(f'  compensator set ({model.family}): in-line {aug.describe()}')
+        except HystIdError as exc:
+            print(f'  compensator set refused: {exc}')
         print(f'  final held-out {d.final.er_holdout_percent:.3g} = '
               f'{d.final.er_holdout_percent / d.noise_floor_percent:.0f} x floor; judged on '
               f'{j["n_samples"]}/{j["n_holdout"]} rows ({j["final_er_percent"]:.3g}); hold '

@@ -35,6 +35,7 @@ from hyst_id.compensation.augment import (Augmentation, augmentation_from_findin
 from hyst_id.diagnosis import diagnose, DiagnoseSettings
 from hyst_id.diagnosis.export import compensator_set
 from hyst_id.diagnosis.mechanisms import Context, MECHANISMS
+from hyst_id.identification.chains import chain_spec
 from hyst_id.io.recording import Recording
 
 pytestmark = pytest.mark.slow
@@ -123,6 +124,12 @@ def test_a_clean_recording_gives_the_plain_set_in_command_units():
     assert d.verdict == 'none', [f.mechanism for f in d.findings]
     model, aug, applied = compensator_set(d)
     assert not aug.active and applied == []
+    # the exported set, run forward in the recording's units, is the diagnosis's model
+    x = np.r_[model.hysteresis, model.backlash]
+    forward = model.output_sign * chain_spec('position', calibration=(1.0, 0.0)).simulate(
+        x, d.t_s, d.command)
+    np.testing.assert_allclose(forward, d.final.prediction, rtol=0,
+                               atol=1e-9 * np.ptp(d.measurement))
     # measured (seeds 4-7): 0.02-0.04 against a noise sd of about 1 in the recording
     assert _rms_error(model, aug) < 0.3
 
