@@ -115,8 +115,8 @@ def test_a_static_curve_is_inverted_with_the_diagnosis_set(seed):
     straight = replace(aug, poly_c2=0.0, poly_c3=0.0)     # the curve's straight part only
     without = _rms_error(model, straight, curve=True)
     inverted = _rms_error(model, aug, curve=True)
-    # measured (seeds 0-1): straight part 3.60-3.63, inverted 0.04-0.08 (0.01-0.02 x)
-    assert inverted < 0.1 * without, (without, inverted)
+    # measured (seeds 0-3): straight part 3.54-3.64, inverted 0.04-0.24 (0.012-0.068 x)
+    assert inverted < 0.15 * without, (without, inverted)
 
 
 def test_a_clean_recording_gives_the_plain_set_in_command_units():
