@@ -132,8 +132,12 @@ def run(args: argparse.Namespace) -> int:
         spec = None if args.domains == 'auto' else make_spec(args, rec)
         diag = diagnose(rec, spec=spec, settings=settings, progress=say)
     print(diag.report())
+    params_error = None
     if args.params_out:
-        _write_params(diag, args.params_out)
+        try:
+            _write_params(diag, args.params_out)
+        except ConfigError as exc:      # the report, JSON and figure are still written
+            params_error = exc
     if updated is not None:
         from hyst_id.rig import save_rig_params
         out = Path(args.sim_out) if args.sim_out else Path(
@@ -154,4 +158,6 @@ def run(args: argparse.Namespace) -> int:
         except OSError as exc:
             raise ConfigError(f'cannot write the figure {args.plot}: {exc.strerror}') from None
         print(f'wrote {path}', file=sys.stderr)
+    if params_error is not None:
+        raise params_error
     return 0

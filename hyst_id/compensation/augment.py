@@ -31,8 +31,9 @@ units and seconds:
   ``t_ref`` say when the compensator's own H and B hold (a set identified on
   the whole record without the block holds on the record's average gain and
   offset: the defaults :func:`augmentation_from_findings` writes). ``t`` is
-  the time since the compensator's start (its first stamped sample after
-  :meth:`AugmentedCompensator.reset`): a schedule holds for runs that start
+  the time since the compensator's first compensated, stamped sample (kept
+  across :meth:`AugmentedCompensator.reset`, restarted by
+  :meth:`AugmentedCompensator.restart_schedules`): a schedule holds for runs that start
   as the recording did (a supply vessel full again); it is held at its value
   at ``schedule_horizon_s`` (the fitted record's length) beyond that, and
   the gain never falls below :data:`MIN_GAIN`.
@@ -66,7 +67,7 @@ from hyst_id.compensation.inverse import CommandLimits, Compensator, InverseMode
 from hyst_id.errors import InvalidParametersError
 
 __all__ = ['AUGMENT_PREFIX', 'Augmentation', 'AugmentedCompensator', 'GAIN_LAWS', 'MIN_GAIN',
-           'augmentation_from_findings']
+           'POLY_RANGE', 'augmentation_from_findings', 'cubic_is_monotone']
 
 #: Prefix of the augmentation's keys in a params file (``augment.dead_time_s`` ...).
 AUGMENT_PREFIX = 'augment.'
@@ -77,6 +78,20 @@ MIN_GAIN = 0.05
 #: The output map is inverted over ``|z| <= POLY_RANGE`` (the record's travel is [-1, 1]).
 POLY_RANGE = 1.25
 _IDENTITY_POLY = (0.0, 1.0, 0.0, 0.0)
+
+
+def cubic_is_monotone(coef: tuple[float, ...], half_range: float) -> bool:
+    """Whether ``c0 + c1 z + c2 z^2 + c3 z^3`` is strictly monotone on ``|z| <= half_range``.
+
+    Exact: the slope ``c1 + 2 c2 z + 3 c3 z^2`` is checked at both ends and at
+    its vertex when that lies inside.
+    """
+    c1, c2, c3 = (float(x) for x in coef[1:4])
+    zs = [-half_range, half_range]
+    if c3 != 0.0 and abs(c2 / (3.0 * c3)) < half_range:
+        zs.append(-c2 / (3.0 * c3))
+    slopes = [c1 + 2.0 * c2 * z + 3.0 * c3 * z * z for z in zs]
+    return all(x > 0 for x in slopes) or all(x < 0 for x in slopes)
 
 
 @dataclass(frozen=True)
@@ -105,8 +120,12 @@ class Augmentation:
                                          f'got {self.gain_law!r}')
         for f in fields(self):
             v = getattr(self, f.name)
-            if f.name != 'gain_law' and (not isinstance(v, (int, float)) or math.isnan(v)):
+            if f.name == 'gain_law':
+                continue
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or math.isnan(v):
                 raise InvalidParametersError(f'augment.{f.name} must be a number, got {v!r}')
+            if f.name not in ('min_command', 'max_command') and not math.isfinite(v):
+                raise InvalidParametersError(f'augment.{f.name} must be finite, got {v!r}')
         if not (math.isfinite(self.dead_time_s) and self.dead_time_s >= 0.0):
             raise InvalidParametersError('augment.dead_time_s must be finite and >= 0')
         if not self.predict_window_s >= 0.0 or not self.schedule_horizon_s >= 0.0:
@@ -117,12 +136,7 @@ class Augmentation:
         if not self.min_command < self.max_command:
             raise InvalidParametersError('augment.min_command must be < augment.max_command')
         if self.has_output_map:
-            c = self.poly
-            if not all(math.isfinite(x) for x in c):
-                raise InvalidParametersError('augment.poly_c0..c3 must be finite')
-            z = np.linspace(-POLY_RANGE, POLY_RANGE, 101)
-            slope = c[1] + 2.0 * c[2] * z + 3.0 * c[3] * z * z
-            if not (np.all(slope > 0) or np.all(slope < 0)):
+            if not cubic_is_monotone(self.poly, POLY_RANGE):
                 raise InvalidParametersError(
                     'augment.poly_c0..c3: the output map is not monotone over |z| <= '
                     f'{POLY_RANGE}, so it has no inverse there')
@@ -312,8 +326,7 @@ class AugmentedCompensator:
 
     @limits.setter
     def limits(self, base: CommandLimits) -> None:
-        self.inner.limits = self.augmentation.limits(base)
-        self.base_limits = base
+        self.configure(self.augmentation, base)
 
     @property
     def bypass(self) -> bool:
@@ -325,9 +338,16 @@ class AugmentedCompensator:
         self.inner.bypass = bool(value)
 
     def reset(self, v0: float) -> None:
-        """Reset the model state and the schedule's time origin."""
+        """Reset the model state (the loop's memory) and the slope history.
+
+        The schedules' time origin is kept: forgetting the loop's memory does not
+        refill a supply (:meth:`restart_schedules` does that).
+        """
         self.inner.reset(v0)
         self._history.clear()
+
+    def restart_schedules(self) -> None:
+        """Start the schedules' time again at the next compensated sample (a new run)."""
         self._t0 = None
 
     def set_model(self, model: InverseModel | None) -> None:
@@ -336,7 +356,19 @@ class AugmentedCompensator:
 
     def set_augmentation(self, augmentation: Augmentation) -> None:
         """Swap the corrections between samples (the schedule's time origin is kept)."""
-        self.inner.limits = augmentation.limits(self.base_limits)
+        self.configure(augmentation, self.base_limits)
+
+    def configure(self, augmentation: Augmentation, limits: CommandLimits) -> None:
+        """Swap the corrections and the base limits together (checked before either changes).
+
+        Raises
+        ------
+        InvalidParametersError
+            The stops leave no command inside the limits (nothing is changed).
+        """
+        narrowed = augmentation.limits(limits)
+        self.inner.limits = narrowed
+        self.base_limits = limits
         self.augmentation = augmentation
 
     def predicted_desired(self, desired: float, t_s: float | None) -> float:
@@ -356,8 +388,9 @@ class AugmentedCompensator:
     def step(self, desired: float, t_s: float | None = None) -> float:
         """Command for one desired output sample (``t_s`` needed by time-based corrections)."""
         aug = self.augmentation
-        if self.inner.model is None or self.inner.bypass or not aug.active:
-            return self.inner.step(desired, t_s)
+        if self.inner.model is None or self.inner.bypass or not aug.active \
+                or not math.isfinite(desired):
+            return self.inner.step(desired, t_s)     # a non-finite value: the last command
         if t_s is not None and self._t0 is None:
             self._t0 = float(t_s)
         target = self.predicted_desired(float(desired), t_s)

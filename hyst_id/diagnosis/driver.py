@@ -256,6 +256,7 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
                                      for c in tied]
         current = winner.fit
         loc = locate(t, v_orig, y, current.prediction, sigma, n_train, ctx.period_s)
+    _final_corrections(findings, mechs, current, ctx, v_orig)
     final_loc = loc if current is not baseline else loc0
     notes = list(rec.notes) + range_note(v_orig, n_train, data.judged_rows.size)
     empirical = None
@@ -280,6 +281,28 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
                                          'hold': current.model.hold
                                          if current.model.dynamic else '',
                                          'judged_holdout': _judged(data, baseline, current)})
+
+
+def _final_corrections(findings: list[Finding], mechs: list[Mechanism], final: FitResult,
+                       ctx: Context, command: np.ndarray) -> None:
+    """Each finding's in-line correction from the *final* fit (what the compensator runs).
+
+    A block accepted in an early round is refitted with every later one, so its
+    values (and the calibration a gain centre or a curve refers to) are taken
+    from the final model, with which they are exported.
+    """
+    model = final.model
+    if model is None:
+        return
+    info = _info(final, ctx, command)
+    by_id = {m.id: m for m in mechs}
+    for f in findings:
+        m = by_id.get(f.mechanism)
+        if m is None or not f.compensation:
+            continue
+        f.compensation['correction'] = (
+            m.correction(model.theta(final.p, m.id), final.coef, info, ctx)
+            if m.id in model.slices else {})
 
 
 def range_note(v: np.ndarray, n_train: int, n_judged: int | None = None) -> list[str]:

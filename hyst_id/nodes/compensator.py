@@ -227,11 +227,23 @@ class Compensator(HystNode):
         tracking = TrackingLink.validate(values)
         if tracking:
             return tracking
-        if any(n.startswith('augment.') for n in changed):
+        augment_changed = any(n.startswith('augment.') for n in changed)
+        if augment_changed or changed & _LIMIT_KEYS or 'tracking.enabled' in changed:
             try:
-                augmentation_from_values(values).limits(_limits(values))
+                aug = augmentation_from_values(values)
+                aug.limits(_limits(values))
             except InvalidParametersError as exc:
-                return f'{exc}; keeping the last corrections'
+                return f'{exc}; keeping the last limits and corrections'
+            if values['tracking.enabled'] and (aug.has_output_map or aug.gain_law != 'none'
+                                               or aug.offset_rate_per_s != 0.0):
+                return ('tracking.enabled with an augment.* schedule or output map: the '
+                        "tracker's prediction is the bare model's, so it would correct "
+                        'the schedule twice; use one of them')
+        if changed & _MODEL_KEYS and not augment_changed and getattr(self, '_comp', None) \
+                is not None and self._comp.augmentation.has_output_map:
+            return ("the in-line output map (augment.poly_*) belongs to the diagnosis's own "
+                    'set, whose H and B output its normalised travel: give a new set together '
+                    'with its augment.* values (identity poly_c0..c3 = 0, 1, 0, 0 to clear it)')
         if values['output_sign'] not in (1.0, -1.0):
             return f'output_sign must be 1.0 or -1.0; got {values["output_sign"]!r}'
         er = values['er_percent']
@@ -262,14 +274,12 @@ class Compensator(HystNode):
         if not hasattr(self, '_comp'):
             return
         before = (self._comp.model, self._comp.limits, self._comp.augmentation)
-        if any(n.startswith('augment.') for n in changed):
+        if any(n.startswith('augment.') for n in changed) or changed & _LIMIT_KEYS:
             aug = augmentation_from_values(values)
-            if aug != self._comp.augmentation:
-                self._comp.set_augmentation(aug)
+            self._comp.configure(aug, _limits(values))     # both or neither (validated)
+            if aug != before[2]:
                 src = self._source_hint or 'set_parameters'
                 self.get_logger().warning(f'in-line corrections from {src}: {aug.describe()}')
-        if changed & _LIMIT_KEYS:
-            self._comp.limits = _limits(values)
         if 'diagnostics_period_s' in changed:
             self._diag_timer.cancel()
             self.destroy_timer(self._diag_timer)

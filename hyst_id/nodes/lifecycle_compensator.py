@@ -33,7 +33,8 @@ driven by the standard lifecycle state machine (``~/change_state``,
 * **deactivate**: commands stop; the actuator holds its last command;
 * **cleanup**: the model state is reset to ``initial_command`` (the loop's
   memory is forgotten: after a cleanup the actuator may have been moved by
-  hand).
+  hand) and the in-line schedules (``augment.*``) start again at the next
+  sample (a new run).
 
 Parameters, sets and services behave as in the compensator in every state.
 """
@@ -98,7 +99,9 @@ class LifecycleCompensator(Compensator, LifecycleNode):
     def on_cleanup(self, state: LifecycleState) -> TransitionCallbackReturn:
         """Forget the loop's memory (restart at ``initial_command``)."""
         self._comp.reset(self.p('initial_command'))
-        self.get_logger().info('cleaned up: model state back at initial_command')
+        self._comp.restart_schedules()   # a new run: augment.* schedules start again
+        self.get_logger().info('cleaned up: model state back at initial_command, in-line '
+                               'schedules restart at the next sample')
         return super().on_cleanup(state)
 
     def on_shutdown(self, state: LifecycleState) -> TransitionCallbackReturn:

@@ -221,3 +221,44 @@ def test_a_map_that_folds_back_is_refused():
                                               'compensation': {'correction': {
                                                   'augment.poly_c2': 0.1}}}], 10.0)
     assert applied[0][1].startswith("not applied: its output map needs the diagnosis's")
+
+
+def test_a_non_finite_desired_value_holds_the_last_command():
+    aug = Augmentation(poly_c0=POLY[0], poly_c1=POLY[1], poly_c2=POLY[2], poly_c3=POLY[3],
+                       offset_rate_per_s=0.01)
+    comp = AugmentedCompensator(_model(), aug, CommandLimits(4.0, 20.0), v0=9.0)
+    v = comp.step(460.0, 0.0)
+    for bad in (float('nan'), float('inf'), -float('inf')):
+        assert comp.step(bad, 0.05) == v
+
+
+def test_limits_and_stops_change_together_or_not_at_all():
+    comp = AugmentedCompensator(_model(), Augmentation(min_command=6.0), CommandLimits(4.0, 20.0))
+    with pytest.raises(InvalidParametersError, match='leave no command'):
+        comp.limits = CommandLimits(4.0, 5.0)
+    assert (comp.limits.min_command, comp.limits.max_command) == (6.0, 20.0)
+    assert comp.base_limits == CommandLimits(4.0, 20.0)
+    comp.configure(Augmentation(min_command=32.0, max_command=38.0), CommandLimits(30.0, 40.0))
+    assert (comp.limits.min_command, comp.limits.max_command) == (32.0, 38.0)
+
+
+def test_a_reset_keeps_the_schedule_and_a_restart_does_not():
+    aug = Augmentation(offset_rate_per_s=1.0)
+    comp = AugmentedCompensator(_model(), aug, CommandLimits(4.0, 20.0), v0=9.0)
+    comp.run(DESIRED[:101], T[:101])                   # 5 s of schedule
+    comp.reset(9.0)
+    after_reset = comp.step(470.0, T[101])
+    comp.restart_schedules()
+    comp.reset(9.0)
+    after_restart = comp.step(470.0, T[101])
+    fresh = AugmentedCompensator(_model(), aug, CommandLimits(4.0, 20.0), v0=9.0)
+    assert after_restart == fresh.step(470.0, T[101]) != after_reset
+
+
+@pytest.mark.parametrize('field, value', [('gain_centre', float('inf')),
+                                          ('offset_rate_per_s', -float('inf')),
+                                          ('predict_window_s', float('inf')),
+                                          ('dead_time_s', True)])
+def test_infinities_and_booleans_are_refused(field, value):
+    with pytest.raises(InvalidParametersError, match=field):
+        Augmentation(**{field: value})

@@ -83,3 +83,31 @@ def test_a_change_of_corrections_is_applied_and_published(ctx):
                                                    schedule_horizon_s=100.0)
     assert sets and sets[-1]['augment']['augment.offset_rate_per_s'] == 0.01
     assert sets[-1]['augment']['augment.min_command'] is None
+
+
+def test_limits_that_the_stops_leave_empty_are_refused_not_raised(ctx):
+    comp = _node(ctx, **{'augment.min_command': 6.0})
+    result = comp.set_parameters_atomically([Parameter('max_command', value=5.0)])
+    assert not result.successful and 'leave no command' in result.reason
+    result = comp.set_parameters_atomically([Parameter('min_command', value=30.0),
+                                             Parameter('max_command', value=40.0),
+                                             Parameter('augment.min_command', value=32.0),
+                                             Parameter('augment.max_command', value=38.0)])
+    assert result.successful, result.reason
+    assert (comp._comp.limits.min_command, comp._comp.limits.max_command) == (32.0, 38.0)
+
+
+def test_tracking_and_a_schedule_are_not_run_together(ctx):
+    comp = _node(ctx, **{'augment.offset_rate_per_s': 0.01})
+    result = comp.set_parameters_atomically([Parameter('tracking.enabled', value=True)])
+    assert not result.successful and 'correct the schedule twice' in result.reason
+
+
+def test_a_set_without_its_output_map_is_refused_while_one_is_in_force(ctx):
+    comp = _node(ctx, **{'augment.poly_c2': 0.1})
+    result = comp.set_parameters_atomically([Parameter('c_t', value=14.5)])
+    assert not result.successful and 'augment.poly_' in result.reason
+    result = comp.set_parameters_atomically([Parameter('c_t', value=14.5),
+                                             Parameter('augment.poly_c2', value=0.0)])
+    assert result.successful, result.reason
+    assert not comp._comp.augmentation.has_output_map

@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from hyst_id.compensation.augment import cubic_is_monotone, POLY_RANGE
 from hyst_id.diagnosis.mechanisms.base import Mechanism, Quantity
 
 __all__ = ['StaticNonlinearity', 'MECHANISM']
@@ -126,10 +127,8 @@ class StaticNonlinearity(Mechanism):
         out = {'augment.poly_c0': c0, 'augment.poly_c1': float(c[labels.index('sensor')]),
                'augment.poly_c2': float(c[labels.index('quantity:1')]),
                'augment.poly_c3': float(c[labels.index('quantity:2')])}
-        z = np.linspace(-1.25, 1.25, 101)
-        slope = out['augment.poly_c1'] + 2 * out['augment.poly_c2'] * z \
-            + 3 * out['augment.poly_c3'] * z * z
-        return out if (np.all(slope > 0) or np.all(slope < 0)) else {}
+        poly = tuple(out[f'augment.poly_c{i}'] for i in range(4))
+        return out if cubic_is_monotone(poly, POLY_RANGE) else {}
 
 
 MECHANISM = StaticNonlinearity()

@@ -37,9 +37,10 @@ AUGMENT_PARAMS = [
           'command is computed for the desired value this far ahead, from its slope; 0 = off',
           low=0.0, high=3600.0, unit='s'),
     Param('augment.predict_window_s', 0.0, 'window of the desired value slope used to predict '
-          'ahead; 0 = the last two samples', low=0.0, high=3600.0, unit='s'),
-    Param('augment.gain_law', 'none', "scheduled plant gain since the node's start: "
-          "'exponential' exp(-rate t) (supply_decay), 'linear' 1 + rate t (gain_drift)",
+          'ahead; 0 = the last two samples', low=0.0, high=60.0, unit='s'),
+    Param('augment.gain_law', 'none', 'scheduled plant gain over the time t since the first '
+          "compensated sample: 'exponential' exp(-rate t) (supply_decay), 'linear' 1 + rate t "
+          '(gain_drift)',
           choices=GAIN_LAWS),
     Param('augment.gain_rate_per_s', 0.0, 'rate of the scheduled gain', low=-10.0, high=10.0,
           unit='1/s'),
