@@ -297,8 +297,11 @@ class Smooth(HysteresisFamily):
         return p
 
     def map_input(self, params: np.ndarray, a: float, b: float) -> np.ndarray:
-        """Command-unit parameters scale with ``a`` (``r_max, v_s``; ``v_c -> a v_c + b``),
-        weights per command unit with ``1 / a``; a play is positively homogeneous."""
+        """The loop for ``v = a v_m + b``: command-unit parameters scale, weights divide.
+
+        ``r_max, v_s`` times ``a``, ``v_c -> a v_c + b``, the weights (per
+        command unit) over ``a``: a play is positively homogeneous.
+        """
         p = np.array(params, dtype=np.float64)
         p[:_WL + 1] /= a
         p[_RMAX] *= a

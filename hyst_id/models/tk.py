@@ -396,8 +396,11 @@ class TaoKokotovic(HysteresisFamily):
         return p
 
     def map_input(self, params: np.ndarray, a: float, b: float) -> np.ndarray:
-        """Side lines ``u = m (v_m - c)``: slope over ``a``, crossing ``a c + b``; flat lines
-        ``u = m v_m + c``: slope over ``a``, intercept ``c - m b / a``."""
+        """The loop for ``v = a v_m + b``: every slope over ``a``, the lines moved to match.
+
+        Side lines ``u = m (v_m - c)`` cross at ``a c + b``; flat lines
+        ``u = m v_m + c`` get the intercept ``c - m b / a``.
+        """
         p = np.array(params, dtype=np.float64)
         m_l, m_r, m_t, m_b, c_l, c_r, c_t, c_b = p[:8]
         p[:8] = (m_l / a, m_r / a, m_t / a, m_b / a, a * c_l + b, a * c_r + b,
