@@ -74,7 +74,7 @@ def compensator_set(d: Diagnosis) -> tuple[InverseModel, Augmentation, list[tupl
                                      'map of the compensator')
     fam = model.spec.family
     nh = fam.n_params
-    x = np.asarray(fit.p[:nh + 3], dtype=float)
+    x = np.array(fit.p[:nh + 3], dtype=float)     # a copy: the diagnosis keeps its own
     scale = tuple(d.extra.get('command_scale', (1.0, 0.0)))
     if scale != (1.0, 0.0):
         try:

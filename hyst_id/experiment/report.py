@@ -208,12 +208,13 @@ ADAPTIVE_TARGETS = {'position': 0.4, 'pressure': 1.5, 'flow': 3.0}
 def _adaptive_table(result: ExperimentResult) -> list[str]:
     """Issue 17: (a) fixed H⁻¹, (b) augmented by the diagnosis, (c) tracking.
 
-    The *perfect compensator* column is %ε_c of a reading that is exactly the
-    desired value through the calibration's lag: how far the desired value
-    itself is from the reference, a floor no compensator can beat.
+    The *desired value vs reference* column is %ε_c of a reading that is
+    exactly the desired value through the calibration's lag: how far the
+    desired value itself is from the reference (a floor when the
+    calibration's lag describes the channel).
     """
     head = ['supply', 'sensor', 'mode', '(a) fixed', '(b) augmented', '(c) tracking',
-            'target', 'perfect compensator (a) / (b)',
+            'target', 'desired value vs reference (a) / (b)',
             'diagnosis of the identification run: what (b) does with it']
     rows = []
     for key, sc in result.scenarios.items():

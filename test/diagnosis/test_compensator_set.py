@@ -122,8 +122,10 @@ def test_a_static_curve_is_inverted_with_the_diagnosis_set(seed):
 def test_a_clean_recording_gives_the_plain_set_in_command_units():
     d = diagnose(_recording(4), settings=SETTINGS)
     assert d.verdict == 'none', [f.mechanism for f in d.findings]
+    p_before = d.final.p.copy()
     model, aug, applied = compensator_set(d)
     assert not aug.active and applied == []
+    assert compensator_set(d)[0] == model and np.array_equal(d.final.p, p_before)
     # the exported set, run forward in the recording's units, is the diagnosis's model
     x = np.r_[model.hysteresis, model.backlash]
     forward = model.output_sign * chain_spec('position', calibration=(1.0, 0.0)).simulate(
