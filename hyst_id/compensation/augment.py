@@ -57,7 +57,7 @@ May import: numpy, :mod:`hyst_id.compensation.inverse`.
 from __future__ import annotations
 
 from collections import deque
-from dataclasses import asdict, dataclass, fields, replace
+from dataclasses import asdict, dataclass, fields
 import math
 from typing import Any, Iterable, Mapping
 
@@ -126,8 +126,8 @@ class Augmentation:
                 raise InvalidParametersError(f'augment.{f.name} must be a number, got {v!r}')
             if f.name not in ('min_command', 'max_command') and not math.isfinite(v):
                 raise InvalidParametersError(f'augment.{f.name} must be finite, got {v!r}')
-        if not (math.isfinite(self.dead_time_s) and self.dead_time_s >= 0.0):
-            raise InvalidParametersError('augment.dead_time_s must be finite and >= 0')
+        if not self.dead_time_s >= 0.0:
+            raise InvalidParametersError('augment.dead_time_s must be >= 0')
         if not self.predict_window_s >= 0.0 or not self.schedule_horizon_s >= 0.0:
             raise InvalidParametersError('augment.predict_window_s and '
                                          'augment.schedule_horizon_s must be >= 0')
@@ -178,23 +178,27 @@ class Augmentation:
         return 0.5 * (lo + hi)
 
     @property
-    def active(self) -> bool:
-        """Whether any correction changes what the plain compensator does."""
-        return self != replace(Augmentation(), predict_window_s=self.predict_window_s,
-                               gain_centre=self.gain_centre,
-                               gain_reference=self.gain_reference,
-                               offset_reference_s=self.offset_reference_s,
-                               schedule_horizon_s=self.schedule_horizon_s)
+    def has_schedule(self) -> bool:
+        """Whether a gain schedule or an offset ramp is set."""
+        return self.gain_law != 'none' or self.offset_rate_per_s != 0.0
 
     @property
     def uses_time(self) -> bool:
         """Whether the corrections need sample times."""
-        return (self.dead_time_s > 0.0 or self.gain_law != 'none'
-                or self.offset_rate_per_s != 0.0)
+        return self.dead_time_s > 0.0 or self.has_schedule
+
+    @property
+    def active(self) -> bool:
+        """Whether any correction changes what the plain compensator does (every sample)."""
+        return (self.uses_time or self.has_output_map or math.isfinite(self.min_command)
+                or math.isfinite(self.max_command))
 
     @classmethod
     def from_mapping(cls, values: Mapping[str, Any]) -> Augmentation:
         """Build from ``augment.*`` keys (others ignored); absent keys keep their defaults.
+
+        A stop given as NaN (``.nan`` in a params file or a ROS parameter, which
+        cannot hold an infinity from every writer) means no stop.
 
         Raises
         ------
@@ -214,6 +218,8 @@ class Augmentation:
                 if isinstance(v, bool):
                     raise TypeError
                 kw[f.name] = float(v)
+                if f.name.endswith('_command') and math.isnan(kw[f.name]):
+                    kw[f.name] = -math.inf if f.name == 'min_command' else math.inf
             except (TypeError, ValueError):
                 raise InvalidParametersError(f'{key} must be a number, got {v!r}') from None
         return cls(**kw)
@@ -232,8 +238,7 @@ class Augmentation:
                          f'{self.gain_centre:.4g} (set at gain {self.gain_reference:.4g})')
         if self.offset_rate_per_s != 0.0:
             parts.append(f'offset ramp {self.offset_rate_per_s:+.4g}/s')
-        if self.schedule_horizon_s > 0.0 and (self.gain_law != 'none'
-                                              or self.offset_rate_per_s != 0.0):
+        if self.schedule_horizon_s > 0.0 and self.has_schedule:
             parts.append(f'schedules held after {self.schedule_horizon_s:.4g} s')
         if math.isfinite(self.min_command) or math.isfinite(self.max_command):
             parts.append(f'stops [{self.min_command:.4g}, {self.max_command:.4g}]')

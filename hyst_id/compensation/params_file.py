@@ -151,11 +151,6 @@ def _augment_values(*sources: Any) -> dict[str, Any]:
         flat.update({k: v for k, v in src.items() if str(k).startswith(AUGMENT_PREFIX)})
     if not flat:
         return {}
-    for key, inf in ((AUGMENT_PREFIX + 'min_command', -math.inf),
-                     (AUGMENT_PREFIX + 'max_command', math.inf)):
-        v = flat.get(key)
-        if isinstance(v, float) and math.isnan(v):
-            flat[key] = inf     # .nan in a file: no stop
     known = set(Augmentation().as_mapping())
     unknown = sorted(set(flat) - known)
     if unknown:

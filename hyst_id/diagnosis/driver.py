@@ -146,7 +146,7 @@ def finding_from(comp: Comparison, before: FitResult, mech: Mechanism, loc: Loca
                    delta_bic=comp.delta_bic, holdout_z=comp.holdout_z,
                    compensation={'kind': mech.compensation,
                                  'how': mech.compensation_note(values, ctx),
-                                 'correction': mech.correction(theta, fit.coef, info, ctx)})
+                                 'correction': {}})      # from the final fit, at the end
 
 
 def diagnose(recording: Recording, *, spec: ChainSpec | None = None,
@@ -298,7 +298,7 @@ def _final_corrections(findings: list[Finding], mechs: list[Mechanism], final: F
     by_id = {m.id: m for m in mechs}
     for f in findings:
         m = by_id.get(f.mechanism)
-        if m is None or not f.compensation:
+        if m is None:
             continue
         f.compensation['correction'] = (
             m.correction(model.theta(final.p, m.id), final.coef, info, ctx)

@@ -234,8 +234,7 @@ class Compensator(HystNode):
                 aug.limits(_limits(values))
             except InvalidParametersError as exc:
                 return f'{exc}; keeping the last limits and corrections'
-            if values['tracking.enabled'] and (aug.has_output_map or aug.gain_law != 'none'
-                                               or aug.offset_rate_per_s != 0.0):
+            if values['tracking.enabled'] and (aug.has_output_map or aug.has_schedule):
                 return ('tracking.enabled with an augment.* schedule or output map: the '
                         "tracker's prediction is the bare model's, so it would correct "
                         'the schedule twice; use one of them')

@@ -25,7 +25,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from hyst_id.compensation.augment import AUGMENT_PREFIX, Augmentation, GAIN_LAWS
+from hyst_id.compensation.augment import Augmentation, GAIN_LAWS
 from hyst_id.nodes.support.params import Param
 
 __all__ = ['AUGMENT_PARAMS', 'augmentation_from_values']
@@ -74,9 +74,4 @@ def augmentation_from_values(values: dict[str, Any]) -> Augmentation:
     InvalidParametersError
         Values that do not make a valid augmentation.
     """
-    mapping = {k: v for k, v in values.items() if k.startswith(AUGMENT_PREFIX)}
-    for key, inf in (('augment.min_command', -math.inf), ('augment.max_command', math.inf)):
-        v = mapping.get(key, _NAN)
-        if isinstance(v, float) and math.isnan(v):
-            mapping[key] = inf
-    return Augmentation.from_mapping(mapping)
+    return Augmentation.from_mapping(values)     # .nan stops: none
