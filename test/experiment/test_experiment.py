@@ -152,8 +152,7 @@ def test_quick_run_has_the_augmented_and_tracking_columns(quick):
         assert np.all((a.command_augmented_ma >= 4.0) & (a.command_augmented_ma <= 20.0))
         # nothing is worse than no compensation at all: (b) 0.31 / 2.12 / 4.53 against
         # uncompensated 4.64 / 8.56 / 5.48 (position / pressure / flow) in the default run
-        # (RESULTS.md); runs whose diagnosis named offset_drift instead gave 6.5 (paper
-        # calibration) and 1.7 (with the offset ramp) on pressure, 4.9 on flow
+        # (`hyst-id experiment`, RESULTS.md)
         assert a.eps_c_augmented_percent < sc.eps_unc_percent[ch], (mode, ch)
     text = format_markdown(quick)
     assert '(b) augmented' in text and '(c) tracking' in text
