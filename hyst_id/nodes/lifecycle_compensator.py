@@ -44,7 +44,6 @@ from __future__ import annotations
 from typing import Any
 
 from rclpy.lifecycle import LifecycleNode, LifecycleState, TransitionCallbackReturn
-from std_msgs.msg import Float64
 
 from hyst_id.compensation.inverse import warm_up
 from hyst_id.nodes.compensator import Compensator, PARAMS
@@ -110,7 +109,7 @@ class LifecycleCompensator(Compensator, LifecycleNode):
         return super().on_shutdown(state)
 
     # -------------------------------------------------------------- traffic
-    def _on_desired(self, msg: Float64) -> None:
+    def _on_desired(self, msg: Any) -> None:
         if self.lifecycle_state != 'active':
             self._dropped += 1
             self.get_logger().info(f'{self.lifecycle_state}: desired samples dropped, no '

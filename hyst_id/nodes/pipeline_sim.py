@@ -33,8 +33,11 @@ or by a fixed ``step_s`` of simulated time per command when it is set:
 then the simulated run does not depend on when messages arrive, and is
 the same on a slow or busy machine (the bringup sets it to each run's
 sample period).
-The flow message (``std_msgs/Float64``) has no header: its time is when it
-was published, so keep the sample period above the node's processing delay.
+With ``topics.flow_type`` ``std_msgs/msg/Float64`` the flow reading has no
+header: its time is when it was published, so keep the sample period above
+the node's processing delay; ``hyst_id_interfaces/msg/StampedValue`` carries
+the reading's stamp (the same as the pressure's). A stamped command
+(``topics.command_type``) acts at its own stamp, not when it arrived.
 
 Calibration gains are positive: the identifier's canonical gauge needs a
 sensor that rises with the actuator output. Sensor time constants are in
@@ -52,7 +55,6 @@ from typing import Any
 from builtin_interfaces.msg import Time
 import numpy as np
 from sensor_msgs.msg import FluidPressure, JointState
-from std_msgs.msg import Float64
 
 from hyst_id.errors import ConfigError
 from hyst_id.models.sensors import first_order_coefficient, second_order_coefficients
@@ -63,8 +65,11 @@ from hyst_id.nodes.support import (
     HystNode,
     OVERRIDABLE,
     Param,
+    scalar_type_param,
+    ScalarStream,
     SENSOR_QOS,
     spin_node,
+    stamp_ns,
     topic_params,
 )
 
@@ -224,6 +229,8 @@ PARAMS = [
           'x time_scale)', low=0.0, high=1e4, unit='s'),
     Param('joint_name', 'valve', 'JointState name of the actuator joint', read_only=True),
     *topic_params(),
+    scalar_type_param('topics.command_type', 'command stream'),
+    scalar_type_param('topics.flow_type', 'flow stream'),
 ]
 
 
@@ -237,14 +244,17 @@ class PipelineSim(HystNode):
         self._last_ns: int | None = None
         self._pres_pub = self.create_publisher(FluidPressure, values['topics.pressure_topic'],
                                                SENSOR_QOS, qos_overriding_options=OVERRIDABLE)
-        self._flow_pub = self.create_publisher(Float64, values['topics.flow_topic'],
+        self._command = ScalarStream(values['topics.command_type'])
+        self._flow = ScalarStream(values['topics.flow_type'])
+        self._flow_pub = self.create_publisher(self._flow.cls, values['topics.flow_topic'],
                                                SENSOR_QOS, qos_overriding_options=OVERRIDABLE)
         self._pos_pub = None
         if values['publish_position']:
             self._pos_pub = self.create_publisher(JointState, values['topics.position_topic'],
                                                   SENSOR_QOS,
                                                   qos_overriding_options=OVERRIDABLE)
-        self.create_subscription(Float64, values['topics.command_topic'], self._on_command,
+        self.create_subscription(self._command.cls, values['topics.command_topic'],
+                                 self._on_command,
                                  COMMAND_QOS, qos_overriding_options=OVERRIDABLE)
         outs = [values['topics.pressure_topic'], values['topics.flow_topic']]
         if self._pos_pub is not None:
@@ -255,12 +265,15 @@ class PipelineSim(HystNode):
     def validate_params(self, values: dict[str, Any], changed: set[str]) -> str | None:
         return actuator_problem(values)
 
-    def _on_command(self, msg: Float64, info: dict) -> None:
-        command = float(msg.data)
+    def _on_command(self, msg: Any, info: dict) -> None:
+        command = self._command.value(msg)
         if not math.isfinite(command):
             self.get_logger().warning('ignored a non-finite command', throttle_duration_sec=5.0)
             return
-        ns = int(info.get('received_timestamp') or 0) or self.get_clock().now().nanoseconds
+        # a stamped command acts at its stamp; an unstamped one when it arrived
+        cmd_stamp = self._command.stamp(msg)
+        ns = stamp_ns(cmd_stamp) if cmd_stamp is not None else (
+            int(info.get('received_timestamp') or 0) or self.get_clock().now().nanoseconds)
         dt_s = 0.0 if self._last_ns is None else (ns - self._last_ns) * 1e-9
         self._last_ns = ns
         step_s = self.p('step_s')
@@ -278,7 +291,7 @@ class PipelineSim(HystNode):
         fp.header.frame_id = 'pressure_transducer'
         fp.fluid_pressure = reading.pressure_pa
         self._pres_pub.publish(fp)
-        self._flow_pub.publish(Float64(data=reading.flow_g_s))
+        self._flow_pub.publish(self._flow.make(reading.flow_g_s, stamp))
 
 
 def main(args: list[str] | None = None) -> int:

@@ -62,10 +62,15 @@ def _ros2_run(prefixes: list[str], package: str, executable: str) -> Path:
 @pytest.fixture(scope='module')
 def install(tmp_path_factory):
     tmp = tmp_path_factory.mktemp('colcon')
+    env = os.environ.copy()
+    for var in ('AMENT_PREFIX_PATH', 'CMAKE_PREFIX_PATH'):   # the wheels' CMake packages
+        env[var] = os.pathsep.join([sys.prefix] + [p for p in env.get(var, '').split(
+            os.pathsep) if p])
     out = subprocess.run(
         [_colcon(), '--log-base', str(tmp / 'log'), 'build', '--base-paths', str(ROOT),
-         '--build-base', str(tmp / 'build'), '--install-base', str(tmp / 'install')],
-        cwd=tmp, capture_output=True, text=True, timeout=600)
+         str(ROOT / 'interfaces'), '--build-base', str(tmp / 'build'),
+         '--install-base', str(tmp / 'install')],
+        cwd=tmp, capture_output=True, text=True, timeout=600, env=env)
     assert out.returncode == 0, out.stdout + out.stderr
     return tmp / 'install'
 
@@ -109,6 +114,54 @@ def test_installed_compensator_starts_and_exits_0_on_sigint(install, ros_domain)
                                 'print(m.__file__)'], env=env, capture_output=True, text=True,
                                cwd=install)
         assert str(site) in probe.stdout, probe.stdout + probe.stderr
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+
+
+def test_installed_interfaces_carry_stamped_streams(install, ros_domain):
+    """The interfaces package colcon built here (not the one ./run built) serves the nodes."""
+    own = install / 'hyst_id_interfaces'
+    pyver = f'python{sys.version_info[0]}.{sys.version_info[1]}'
+    env = os.environ.copy()
+
+    def paths(var, first):
+        rest = [p for p in env.get(var, '').split(os.pathsep)
+                if p and 'hyst_id_interfaces' not in p]
+        env[var] = os.pathsep.join([str(x) for x in first] + rest)
+
+    paths('AMENT_PREFIX_PATH', [own, install / 'hyst_id'])
+    paths('PYTHONPATH', [own / 'lib' / pyver / 'site-packages',
+                         install / 'hyst_id' / 'lib' / pyver / 'site-packages'])
+    paths('LD_LIBRARY_PATH', [own / 'lib'])
+    probe = subprocess.run(
+        [sys.executable, '-c', 'import hyst_id_interfaces.msg as m; print(m.__file__); '
+         'print(m.StampedValue(value=2.5).value, m.IdentifiedParams(names=["a"]).names)'],
+        env=env, capture_output=True, text=True, cwd=install, timeout=60)
+    assert probe.returncode == 0, probe.stderr
+    assert str(own) in probe.stdout and "2.5 ['a']" in probe.stdout, probe.stdout
+    exe = _ros2_run(env['AMENT_PREFIX_PATH'].split(os.pathsep), 'hyst_id', 'compensator')
+    share = install / 'hyst_id' / 'share' / 'hyst_id' / 'params'
+    proc = subprocess.Popen([str(exe), '--ros-args', '--params-file',
+                             str(share / 'compensator.yaml'), '--params-file',
+                             str(share / 'stamped.yaml')], env=env,
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    try:
+        deadline = time.monotonic() + 30.0
+        seen = ''
+        while time.monotonic() < deadline and 'compensating' not in seen:
+            line = proc.stdout.readline()
+            if not line and proc.poll() is not None:
+                break
+            seen += line
+        assert 'compensating /hyst_id/desired -> /hyst_id/command' in seen, seen
+        proc.send_signal(signal.SIGINT)
+        rest, _ = proc.communicate(timeout=15)
+        assert proc.returncode == 130, seen + rest
+        assert 'desired hyst_id_interfaces/msg/StampedValue; command hyst_id_interfaces/msg/' \
+            'StampedValue' in seen, seen
+        assert 'Traceback' not in seen + rest and 'unknown' not in seen + rest, seen + rest
     finally:
         if proc.poll() is None:
             proc.kill()

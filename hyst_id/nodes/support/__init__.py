@@ -18,7 +18,13 @@ Nodes import from here; the core never does (it does not import rclpy).
 """
 
 from hyst_id.nodes.support.hyst_node import HystNode
-from hyst_id.nodes.support.params import field_params, Param, TOPIC_KEYS, topic_params
+from hyst_id.nodes.support.params import (
+                                          field_params,
+                                          Param,
+                                          scalar_type_param,
+                                          TOPIC_KEYS,
+                                          topic_params,
+)
 from hyst_id.nodes.support.pusher import ParameterPusher
 from hyst_id.nodes.support.qos import (
                                        COMMAND_QOS,
@@ -31,6 +37,7 @@ from hyst_id.nodes.support.qos import (
                                        SENSOR_QOS,
 )
 from hyst_id.nodes.support.ros import (
+                                       check_field,
                                        diagnostic_array,
                                        exit_code_after,
                                        EXIT_SIGINT,
@@ -47,13 +54,16 @@ from hyst_id.nodes.support.ros import (
                                        try_publish,
                                        type_mismatches,
 )
+from hyst_id.nodes.support.scalar import ScalarStream
 
 __all__ = [
-    'COMMAND_QOS', 'DESIRED_TOPIC', 'DIAGNOSTICS_QOS', 'DIAGNOSTICS_TOPIC', 'EXIT_SIGINT',
+    'COMMAND_QOS', 'DESIRED_TOPIC', 'check_field', 'DIAGNOSTICS_QOS', 'DIAGNOSTICS_TOPIC',
+    'EXIT_SIGINT',
     'IDENTIFIED_PARAMS_TOPIC', 'LATCHED_QOS', 'OVERRIDABLE', 'SENSOR_QOS', 'TOPIC_KEYS',
     'diagnostic_array', 'exit_code_after', 'field_params', 'HystNode', 'init_ros',
     'input_problems',
-    'message_class', 'Param', 'ParameterPusher', 'resolved', 'source_time_ns',
+    'message_class', 'Param', 'ParameterPusher', 'resolved', 'ScalarStream',
+    'scalar_type_param', 'source_time_ns',
     'spin_in_background', 'spin_node', 'spin_until_stopped', 'stamp_ns', 'stop_signals',
     'topic_params', 'try_publish', 'type_mismatches',
 ]

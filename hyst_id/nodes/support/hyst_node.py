@@ -41,6 +41,9 @@ _TYPE_NAMES = {bool: 'a bool', int: 'an integer', float: 'a double', str: 'a str
 
 
 #: Parameters rclpy itself reads, and prefixes of parameter families it owns.
+#: Stream-type keys a ``/**`` params file may give every node (params/stamped.yaml):
+#: the nodes that carry the stream declare them, the others ignore them.
+STREAM_TYPE_KEYS = ('topics.desired_type', 'topics.output_type')
 _ROS_OWN = frozenset({'use_sim_time', 'start_type_description_service'})
 _ROS_OWN_PREFIXES = ('qos_overrides.',)
 
@@ -49,12 +52,12 @@ def unknown_overrides(overrides: Iterable[str], declared: Iterable[str]) -> list
     """Names given by a params file or ``-p`` that no parameter of the node matches.
 
     Keys of the shared ``params/topics.yaml`` (``topics.<channel>_topic`` ...,
-    given to every node through ``/**``) and rclpy's own parameters are not
-    unknown; anything else (a typo such as ``max_comand``, another node's
-    key) is.
+    given to every node through ``/**``), :data:`STREAM_TYPE_KEYS` and
+    rclpy's own parameters are not unknown; anything else (a typo such as
+    ``max_comand``, another node's key) is.
     """
     declared = set(declared)
-    shared = {f'topics.{k}' for k in TOPIC_FILE_KEYS}
+    shared = {f'topics.{k}' for k in TOPIC_FILE_KEYS} | set(STREAM_TYPE_KEYS)
     return sorted(n for n in overrides if n not in declared and n not in shared
                   and n not in _ROS_OWN and not n.startswith(_ROS_OWN_PREFIXES))
 

@@ -42,6 +42,8 @@ PARAMS = [
           read_only=True),
     Param('topics.identified_params_topic', IDENTIFIED_PARAMS_TOPIC,
           'latched identified parameters (std_msgs/String, JSON)', read_only=True),
+    Param('topics.identified_typed_topic', '~/identified', 'latched identified parameters, '
+          "typed (hyst_id_interfaces/msg/IdentifiedParams; '' = JSON only)", read_only=True),
     Param('measurement_reliable', False, 'subscribe to the measurement with reliable QoS '
           '(for replays; live sensors are best effort)', read_only=True),
     Param('collect', True, 'accumulate samples from the topics'),

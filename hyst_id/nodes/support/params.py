@@ -22,10 +22,11 @@ from typing import Any, Iterable
 
 from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
 
+from hyst_id.io.interface_types import FLOAT64_TYPE, SCALAR_TYPES, STAMPED_VALUE_TYPE
 from hyst_id.io.recording import CHANNELS
 from hyst_id.io.topics import TopicConfig
 
-__all__ = ['Param', 'TOPIC_KEYS', 'field_params', 'topic_params']
+__all__ = ['Param', 'TOPIC_KEYS', 'field_params', 'scalar_type_param', 'topic_params']
 
 
 @dataclass(frozen=True)
@@ -95,10 +96,25 @@ def topic_params(keys: Iterable[str] = TOPIC_KEYS) -> list[Param]:
     return out
 
 
+def scalar_type_param(name: str, what: str, default: str = FLOAT64_TYPE) -> Param:
+    """The read-only ``topics.<stream>_type`` parameter of the scalar stream ``what``."""
+    return Param(name, default, f'message type of the {what}: {FLOAT64_TYPE} (unstamped) or '
+                 f'{STAMPED_VALUE_TYPE} (header stamp = the time the value stands for; '
+                 'needs the hyst_id_interfaces package)', read_only=True, choices=SCALAR_TYPES)
+
+
 def field_params() -> list[Param]:
-    """Read-only ``topics.command_field`` and ``topics.<channel>_type`` / ``_field``."""
-    out = [Param('topics.command_field', TopicConfig().command_field,
-                 'field of the command message', read_only=True)]
+    """Read-only ``topics.command_type`` / ``_field`` and ``topics.<channel>_type`` / ``_field``.
+
+    ``topics.command_type`` is a scalar stream type (``std_msgs/msg/Float64``
+    or ``hyst_id_interfaces/msg/StampedValue``); a channel's type may be any
+    message type that holds its field.
+    """
+    out = [scalar_type_param('topics.command_type', 'command stream',
+                             TopicConfig().command_type),
+           Param('topics.command_field', TopicConfig().command_field,
+                 'field of the command message (data for Float64, value for StampedValue)',
+                 read_only=True)]
     for ch in CHANNELS:
         cfg = TopicConfig.for_channel(ch)
         out += [Param(f'topics.{ch}_type', cfg.measurement_type, f'message type of {ch}',

@@ -39,7 +39,8 @@ from rclpy.signals import SignalHandlerOptions
 
 from hyst_id.errors import ConfigError, HystIdError
 
-__all__ = ['EXIT_SIGINT', 'diagnostic_array', 'exit_code_after', 'first_line', 'init_ros',
+__all__ = ['EXIT_SIGINT', 'check_field', 'diagnostic_array', 'exit_code_after', 'first_line',
+           'init_ros',
            'input_problems', 'message_class', 'resolved', 'source_time_ns',
            'spin_in_background', 'spin_node', 'spin_until_stopped', 'stamp_ns', 'stop_signals',
            'try_publish', 'type_mismatches']
@@ -59,6 +60,18 @@ def message_class(type_name: str) -> type:
         return getattr(module, parts[2])
     except (ImportError, AttributeError):
         raise ConfigError(f'message type {type_name} is not installed') from None
+
+
+def check_field(cls: type, path: tuple, param: str) -> None:
+    """Raise ConfigError when the field path ``path`` (parsed) cannot be in ``cls``'s messages.
+
+    Checks the first name of the path (indices and nested names depend on
+    the message's contents); ``param`` names the parameter in the error.
+    """
+    fields = list(getattr(cls, 'get_fields_and_field_types', dict)())
+    if path and isinstance(path[0], str) and fields and path[0] not in fields:
+        raise ConfigError(f'{param}: {cls.__module__.split(".")[0]}/msg/{cls.__name__} has no '
+                          f'field {path[0]!r} (fields: {", ".join(fields)})')
 
 
 def init_ros(args: list[str] | None, name: str) -> bool:
