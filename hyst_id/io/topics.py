@@ -28,10 +28,12 @@ import re
 from typing import Any
 
 from hyst_id.errors import ConfigError
+from hyst_id.io.interface_types import STAMPED_VALUE_TYPE
 from hyst_id.io.params_file import read_yaml
 from hyst_id.io.recording import CHANNELS
 
-__all__ = ['NamedIndex', 'TOPIC_FILE_KEYS', 'TopicConfig', 'get_field', 'load_topic_config',
+__all__ = ['NamedIndex', 'NODE_STREAM_KEYS', 'TOPIC_FILE_KEYS', 'TopicConfig', 'get_field',
+           'load_topic_config',
            'parse_field_path']
 
 #: Per channel: topic, message type, field path, unit.
@@ -46,6 +48,9 @@ _KEYS = frozenset([f'command_{s}' for s in _SUFFIXES] + ['stamp_source']
                   + [f'{ch}_{s}' for ch in CHANNELS for s in _SUFFIXES])
 #: Every key ``params/topics.yaml`` may hold (shared by all nodes through ``/**``).
 TOPIC_FILE_KEYS = _KEYS
+#: Keys of a ``/**`` topics mapping that only nodes read (``params/stamped.yaml``: the
+#: compensator's desired stream and the excitation's output); recordings ignore them.
+NODE_STREAM_KEYS = frozenset({'desired_type', 'output_type'})
 _INDEX = r'\[(\d+|[A-Za-z_][\w.-]*)\]'
 _FIELD_RE = re.compile(rf'[A-Za-z_]\w*({_INDEX})*(\.[A-Za-z_]\w*({_INDEX})*)*')
 
@@ -170,7 +175,8 @@ class TopicConfig:
             ``command_type``, ``command_field``, ``command_unit``,
             ``<channel>_topic``, ``<channel>_type``, ``<channel>_field``,
             ``<channel>_unit`` (keys of other channels are ignored) and
-            ``stamp_source``.
+            ``stamp_source``. A ``*_type`` of ``hyst_id_interfaces/msg/StampedValue``
+            without its ``*_field`` reads ``value``.
 
         Raises
         ------
@@ -189,6 +195,9 @@ class TopicConfig:
                                       ('measurement', channel, defaults)):
             for i, suffix in enumerate(_SUFFIXES):
                 values[f'{role}_{suffix}'] = params.get(f'{prefix}_{suffix}', default[i])
+            if params.get(f'{prefix}_type') == STAMPED_VALUE_TYPE \
+                    and f'{prefix}_field' not in params:
+                values[f'{role}_field'] = 'value'       # a stamped scalar's value
         values['stamp_source'] = params.get('stamp_source', 'header')
         return cls(**values)
 
@@ -220,8 +229,9 @@ def load_topic_config(yaml_path: str | Path, channel: str, *,
     def take(where: str, section: Any, strict: bool) -> None:
         if not isinstance(section, dict):
             raise ConfigError(f'{yaml_path}: {where} must be a mapping')
-        if strict and set(section) - _KEYS:
-            raise ConfigError(f'{yaml_path}: unknown key(s) {sorted(set(section) - _KEYS)} in '
+        unknown = set(section) - _KEYS - NODE_STREAM_KEYS
+        if strict and unknown:
+            raise ConfigError(f'{yaml_path}: unknown key(s) {sorted(unknown)} in '
                               f'{where}; known: {sorted(_KEYS)}')
         merged.update({k: v for k, v in section.items() if k in _KEYS})
 

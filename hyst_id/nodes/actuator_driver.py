@@ -168,6 +168,7 @@ class ActuatorDriver(HystNode):
         self.create_subscription(self._command.cls, self.p('topics.command_topic'),
                                  self._on_command,
                                  COMMAND_QOS, qos_overriding_options=OVERRIDABLE)
+        self.watch_input_types([(self.p('topics.command_topic'), self._command.type_name)])
         self.get_logger().info(
             f'{type(actuator).__name__}: {self.p("topics.command_topic")} -> '
             f'{self.p("topics.position_topic")} (joint {self.p("joint_name")!r})')

@@ -58,7 +58,7 @@ from rclpy.task import Future
 
 from hyst_id.errors import HystIdError
 from hyst_id.io.recording import CHANNELS
-from hyst_id.io.topics import get_field, parse_field_path, TopicConfig
+from hyst_id.io.topics import get_field, parse_field_path
 from hyst_id.live.buffer import SampleBuffer
 from hyst_id.nodes.actuator_driver import ActuatorDriver
 from hyst_id.nodes.compensator import Compensator
@@ -208,7 +208,6 @@ class Bringup(HystNode):
         self._periods = {'identify': v['identify_sample_period_s'],
                          'compensate': v['compensate_sample_period_s']}
         self.pipeline.set_parameters([Parameter('step_s', value=self._periods['identify'])])
-        cfg = TopicConfig.for_channel(ch)
         self._field = parse_field_path(self.identifier.p(f'topics.{ch}_field'))
         self._buffers = {'uncompensated': SampleBuffer(), 'compensated': SampleBuffer()}
         self._phase = 'start'
@@ -216,12 +215,14 @@ class Bringup(HystNode):
         self._t0 = time.monotonic()
         self._identified = False
         self.identifier.on_identified = lambda doc: setattr(self, '_identified', True)
-        self.create_subscription(message_class(cfg.measurement_type),
+        # the identifier's names and types (relative: the graph's namespace applies)
+        self.create_subscription(message_class(self.identifier.p(f'topics.{ch}_type')),
                                  self.identifier.p(f'topics.{ch}_topic'), self._on_measurement,
                                  SENSOR_QOS)
         self._streams = {'uncompensated': ScalarStream(v['topics.command_type']),
                          'compensated': ScalarStream(v['topics.desired_type'])}
-        self.create_subscription(self._streams['uncompensated'].cls, cfg.command_topic,
+        self.create_subscription(self._streams['uncompensated'].cls,
+                                 self.identifier.p('topics.command_topic'),
                                  lambda m, i: self._on_reference('uncompensated', m, i),
                                  COMMAND_QOS)
         self.create_subscription(self._streams['compensated'].cls, DESIRED_TOPIC,

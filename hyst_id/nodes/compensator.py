@@ -69,6 +69,7 @@ from hyst_id.nodes.support import (
     field_params,
     HystNode,
     IDENTIFIED_PARAMS_TOPIC,
+    input_problems,
     LATCHED_QOS,
     OVERRIDABLE,
     Param,
@@ -80,7 +81,6 @@ from hyst_id.nodes.support import (
     TOPIC_KEYS,
     topic_params,
     try_publish,
-    type_mismatches,
 )
 from hyst_id.nodes.support.augment import AUGMENT_PARAMS, augmentation_from_values
 from hyst_id.nodes.support.tracking import SENSOR_KEYS, TRACKING_PARAMS, TrackingLink
@@ -183,15 +183,16 @@ class Compensator(HystNode):
             warm_up(model)
         self._comp = AugmentedCompensator(model, augmentation_from_values(values),
                                           _limits(values), v0=values['initial_command'])
+        self._desired = ScalarStream(values['topics.desired_type'])
+        self._command = ScalarStream(values['topics.command_type'])
         self._tracking = TrackingLink(self)
+        self._tracking.use_stamps = self._desired.stamped
         self._tracking.configure(values, self._comp)
         self._source = 'params' if model is not None else ''
         self._n = 0
         self._not_sent = 0
         self._generation = 0
         self._step_ns: deque[int] = deque(maxlen=2000)
-        self._desired = ScalarStream(values['topics.desired_type'])
-        self._command = ScalarStream(values['topics.command_type'])
         self._cmd_pub = self.create_publisher(self._command.cls, self.p('topics.command_topic'),
                                               COMMAND_QOS, qos_overriding_options=OVERRIDABLE)
         self._set_pub = self.create_publisher(String, '~/active_set', ACTIVE_SET_QOS)
@@ -458,11 +459,13 @@ class Compensator(HystNode):
                   'generation': self._generation, 'rejected_updates': self.rejected_updates,
                   'bypass': self._comp.bypass,
                   'commands_not_sent': self._not_sent, **self._tracking.status()}
-        want = self._desired.type_name
-        wrong = type_mismatches(self, self.p('topics.desired_topic'), want)
+        inputs = [(self.p('topics.desired_topic'), self._desired.type_name)]
+        if self._tracking.adaptive is not None:     # the measurement tracking reads
+            ch = self.p('channel')
+            inputs.append((self.p(f'topics.{ch}_topic'), self.p(f'topics.{ch}_type')))
+        wrong = input_problems(self, inputs, {}, 0.0, math.inf, {})
         if wrong:
-            text = (f'{resolved(self, self.p("topics.desired_topic"))}: {", ".join(wrong)}, '
-                    f'expected {want} (never received)')
+            text = '; '.join(wrong)
             self.get_logger().error(text, throttle_duration_sec=10.0)
             self.publish_diagnostics(2, text, values)
         elif self._not_sent:

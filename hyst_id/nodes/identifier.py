@@ -112,13 +112,11 @@ class Identifier(HystNode):
         self.handed_over: Identification | None = None
         self.last_document: dict | None = None
         self.last_diagnosis: dict | None = None
-        self.last_error = ''
+        self.last_error, self._eor_tried, self._requested = '', False, set()
         self.on_identified: Callable[[dict], None] | None = None
         self._cancelled: list[IdentificationJob | DiagnosisJob] = []
         self._last_rec: Recording | None = None
         self._diag_statuses: list[DiagnosticStatus] = []
-        self._eor_tried = False
-        self._requested: set[str] = set()
         self._pusher = ParameterPusher(self)
         self.sliding = SlidingLink(self)
         self._started = time.monotonic()
@@ -489,6 +487,8 @@ class Identifier(HystNode):
             level, msg = 1, self._gate_message
         elif self.last_document:
             values['last_er_percent'] = self.last_document.get('er_percent') or math.nan
+            if self.last_document.get('warnings'):     # the set's warnings stay visible
+                level, msg = 1, msg + '; last set: ' + ' | '.join(self.last_document['warnings'])
         values.update(self.sliding.status())
         problems = input_problems(   # a wrong type, or one input arriving without the other
             self, self._expected, self._rx, self._started, self.p('input_timeout_s'),

@@ -256,6 +256,7 @@ class PipelineSim(HystNode):
         self.create_subscription(self._command.cls, values['topics.command_topic'],
                                  self._on_command,
                                  COMMAND_QOS, qos_overriding_options=OVERRIDABLE)
+        self.watch_input_types([(values['topics.command_topic'], self._command.type_name)])
         outs = [values['topics.pressure_topic'], values['topics.flow_topic']]
         if self._pos_pub is not None:
             outs.append(values['topics.position_topic'])

@@ -29,6 +29,7 @@ import numpy as np
 from hyst_id.io.bag import BagWriter, default_typestore
 from hyst_id.io.interface_types import INTERFACE_MSGS, STAMPED_VALUE_TYPE
 from hyst_id.io.readers import read_recording
+from hyst_id.io.topics import load_topic_config
 
 __all__: list[str] = []
 
@@ -82,3 +83,12 @@ def test_stamped_commands_are_timed_by_their_stamps_not_the_log(tmp_path):
     np.testing.assert_allclose(np.diff(got.t_s), 0.1, atol=1e-6)
     np.testing.assert_allclose(got.measurement, flow, rtol=1e-12)
     np.testing.assert_allclose(got.command, command, rtol=1e-12)
+    # hyst-id identify --topics params/stamped.yaml: the nodes' stream keys are ignored,
+    # and a StampedValue is read at its value field without naming it
+    cfg = load_topic_config(MSG_DIR.parents[2] / 'params' / 'stamped.yaml', 'flow')
+    assert (cfg.command_field, cfg.measurement_field) == ('value', 'value')
+    again = read_recording(tmp_path / 'bag', 'flow', topics=cfg)
+    np.testing.assert_array_equal(again.t_s, got.t_s)
+    lean = read_recording(tmp_path / 'bag', 'flow', topics={
+        'command_type': STAMPED_VALUE_TYPE, 'flow_type': STAMPED_VALUE_TYPE})
+    np.testing.assert_array_equal(lean.measurement, got.measurement)

@@ -229,3 +229,32 @@ def test_bypass_and_reset_services(ctx):
     assert comp.step(12.345) != 12.345                 # compensated again
     future = reset.call_async(Trigger.Request())
     assert _spin_until(ctx, future.done) and 'reset' in future.result().message
+
+
+def test_the_last_sets_warnings_stay_on_diagnostics(ctx):
+    """A set published with warnings keeps the identifier's status at WARN, not one tick."""
+    statuses = _statuses(ctx)
+    ident = make_node(ctx, Identifier, parameter_overrides=FAST)
+    ident.last_document = {'er_percent': 0.5, 'warnings': ['c_t is not identifiable']}
+    seen = []
+    assert _spin_until(ctx, lambda: len(seen.extend(
+        s for s in statuses if s[0] == 'hyst_id: identifier') or seen) >= 3, timeout=10.0)
+    assert all(lvl == 1 and 'c_t is not identifiable' in m for _, lvl, m in seen[-3:]), seen
+
+
+def test_a_float64_command_publisher_is_an_error_at_a_stamped_actuator(ctx):
+    statuses = _statuses(ctx)
+    from hyst_id.nodes.actuator_driver import ActuatorDriver
+    make_node(ctx, ActuatorDriver, parameter_overrides=[
+        Parameter('topics.command_type', value='hyst_id_interfaces/msg/StampedValue')])
+    other = rclpy.Context()            # another participant, as another process would be
+    rclpy.init(context=other)
+    try:
+        io = Node('io', context=other)
+        io.create_publisher(Float64, 'hyst_id/command', COMMAND_QOS)
+        assert _spin_until(ctx, lambda: any(
+            n == 'hyst_id: actuator_driver' and lvl == 2 and 'std_msgs/msg/Float64' in m
+            for n, lvl, m in statuses), timeout=10.0), statuses
+        io.destroy_node()
+    finally:
+        other.try_shutdown()

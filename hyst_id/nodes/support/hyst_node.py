@@ -16,6 +16,8 @@
 
 from __future__ import annotations
 
+import math
+import time
 from typing import Any, Iterable, Mapping, Sequence
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
@@ -29,10 +31,16 @@ from rclpy.exceptions import (
 from rclpy.node import Node
 
 from hyst_id.errors import ConfigError
-from hyst_id.io.topics import TOPIC_FILE_KEYS
+from hyst_id.io.topics import NODE_STREAM_KEYS, TOPIC_FILE_KEYS
 from hyst_id.nodes.support.params import Param
 from hyst_id.nodes.support.qos import DIAGNOSTICS_QOS, DIAGNOSTICS_TOPIC
-from hyst_id.nodes.support.ros import diagnostic_array, first_line, try_publish
+from hyst_id.nodes.support.ros import (
+    diagnostic_array,
+    first_line,
+    input_problems,
+    resolved,
+    try_publish,
+)
 
 __all__ = ['HystNode', 'unknown_overrides']
 
@@ -40,10 +48,10 @@ _TYPE_NAMES = {bool: 'a bool', int: 'an integer', float: 'a double', str: 'a str
                list: 'an array'}
 
 
-#: Parameters rclpy itself reads, and prefixes of parameter families it owns.
 #: Stream-type keys a ``/**`` params file may give every node (params/stamped.yaml):
 #: the nodes that carry the stream declare them, the others ignore them.
-STREAM_TYPE_KEYS = ('topics.desired_type', 'topics.output_type')
+STREAM_TYPE_KEYS = tuple(sorted(f'topics.{k}' for k in NODE_STREAM_KEYS))
+#: Parameters rclpy itself reads, and prefixes of parameter families it owns.
 _ROS_OWN = frozenset({'use_sim_time', 'start_type_description_service'})
 _ROS_OWN_PREFIXES = ('qos_overrides.',)
 
@@ -214,3 +222,24 @@ class HystNode(Node):
         arr = diagnostic_array(self, f'hyst_id: {self.get_name()}', level, message, values)
         arr.status.extend(extra)
         try_publish(self._diag_pub, arr)
+
+    def watch_input_types(self, expected: Sequence[tuple[str, str]],
+                          period_s: float = 1.0) -> None:
+        """Publish this node's ``/diagnostics`` status every ``period_s``.
+
+        ERROR (and a log line) while a publisher of another message type than
+        expected is on one of the ``(topic, type)`` inputs (the middleware
+        never delivers its messages: without this, silence); OK otherwise.
+        """
+        started = time.monotonic()
+
+        def check() -> None:
+            problems = input_problems(self, expected, {}, started, math.inf, {})
+            if problems:
+                self.get_logger().error('; '.join(problems), throttle_duration_sec=10.0)
+                self.publish_diagnostics(2, '; '.join(problems))
+            else:
+                self.publish_diagnostics(0, 'running: ' + ', '.join(
+                    f'{resolved(self, t)} ({want})' for t, want in expected))
+
+        self.create_steady_timer(period_s, check)

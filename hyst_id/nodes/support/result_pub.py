@@ -24,10 +24,12 @@ parsing JSON. Both latched.
 
 from __future__ import annotations
 
+import datetime
 import json
 import math
 from typing import Any
 
+from builtin_interfaces.msg import Time
 from rclpy.node import Node
 from rclpy.qos import QoSProfile
 from std_msgs.msg import String
@@ -36,7 +38,7 @@ from hyst_id.errors import ConfigError
 from hyst_id.io.interface_types import IDENTIFIED_PARAMS_TYPE
 from hyst_id.nodes.support.ros import message_class
 
-__all__ = ['ResultPublisher', 'identified_params_message']
+__all__ = ['ResultPublisher', 'finished_ns', 'identified_params_message']
 
 
 def _number(value: Any) -> float | None:
@@ -45,15 +47,33 @@ def _number(value: Any) -> float | None:
     return float(value)
 
 
+def _or_nan(value: Any) -> float:
+    number = _number(value)
+    return math.nan if number is None else number
+
+
+def finished_ns(doc: dict) -> int:
+    """When the document's identification finished (``identified_at``), ns; 0 if unknown."""
+    try:
+        when = datetime.datetime.fromisoformat(str(doc['identified_at']))
+    except (KeyError, ValueError):
+        return 0        # e.g. a set recovered from a params file
+    return int(round(when.timestamp() * 1e9))
+
+
 def identified_params_message(cls: type, doc: dict, stamp: Any) -> Any:
-    """An ``IdentifiedParams`` of class ``cls`` holding the result document ``doc``."""
+    """An ``IdentifiedParams`` of class ``cls`` holding the result document ``doc``.
+
+    ``stamp`` (``builtin_interfaces/Time``) is when the identification finished;
+    zero when that is not known (a set recovered from a params file).
+    """
     params = {k: _number(v) for k, v in (doc.get('params') or {}).items()}
     params = {k: v for k, v in params.items() if v is not None}
     gate = doc.get('gate') or {}
     msg = cls(channel=str(doc.get('channel', '')), family=str(doc.get('family', '')),
               names=list(params), values=list(params.values()),
-              er_percent=_number(doc.get('er_percent')) or math.nan,
-              noise_floor_percent=_number(doc.get('noise_floor_percent')) or math.nan,
+              er_percent=_or_nan(doc.get('er_percent')),
+              noise_floor_percent=_or_nan(doc.get('noise_floor_percent')),
               warnings=[str(w) for w in doc.get('warnings') or ()],
               handed_over=doc.get('compensator_params') is not None,
               gate_reasons=[str(r) for r in gate.get('reasons') or ()],
@@ -104,5 +124,6 @@ class ResultPublisher:
         """Publish ``doc`` on both topics."""
         self._json.publish(String(data=json.dumps(doc)))
         if self._typed is not None:
-            self._typed.publish(identified_params_message(
-                self._cls, doc, self._node.get_clock().now().to_msg()))
+            sec, nanosec = divmod(finished_ns(doc), 1_000_000_000)
+            stamp = Time(sec=sec, nanosec=nanosec)
+            self._typed.publish(identified_params_message(self._cls, doc, stamp))

@@ -32,11 +32,11 @@ from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 from hyst_id.compensation import Compensator as CoreCompensator
 from hyst_id.compensation.tracking import (AdaptiveCompensator, GainOffsetTracker,
                                            SensorPredictor)
-from hyst_id.errors import InvalidParametersError
+from hyst_id.errors import ConfigError, InvalidParametersError
 from hyst_id.io.topics import get_field, parse_field_path
 from hyst_id.nodes.support.params import Param
 from hyst_id.nodes.support.qos import OVERRIDABLE
-from hyst_id.nodes.support.ros import message_class
+from hyst_id.nodes.support.ros import check_field, message_class, stamp_ns
 
 __all__ = ['SENSOR_KEYS', 'TRACKING_PARAMS', 'TrackingLink']
 
@@ -94,6 +94,9 @@ class TrackingLink:
         self._field = None
         self._channel = ''
         self.bad_samples = 0
+        #: time measurements by their header stamps (the compensator runs on stamped
+        #: desired values); else by the node's clock, as unstamped desired values are
+        self.use_stamps = False
 
     @staticmethod
     def validate(values: dict[str, Any]) -> str | None:
@@ -102,8 +105,12 @@ class TrackingLink:
             return None
         try:
             sensor_predictor(values)
-        except InvalidParametersError as exc:
-            return str(exc)
+            channel = values['channel']
+            check_field(message_class(values[f'topics.{channel}_type']),
+                        parse_field_path(values[f'topics.{channel}_field']),
+                        f'topics.{channel}_field')
+        except (InvalidParametersError, ConfigError) as exc:
+            return f'tracking: {exc}'
         return None
 
     def configure(self, values: dict[str, Any], comp: CoreCompensator) -> None:
@@ -114,6 +121,9 @@ class TrackingLink:
                 log.warning('tracking off: the desired value is no longer corrected')
             self.adaptive = None
             return
+        problem = self.validate(values)
+        if problem:         # at start (a set is refused in the on-set callback before)
+            raise ConfigError(problem)
         channel = values['channel']
         if self._sub is not None and channel != self._channel:
             self.node.destroy_subscription(self._sub)
@@ -147,7 +157,9 @@ class TrackingLink:
             self.node.get_logger().warning(f'tracking: cannot read the measurement ({exc})',
                                            throttle_duration_sec=5.0)
             return
-        t_s = self.node.get_clock().now().nanoseconds * 1e-9
+        header = getattr(msg, 'header', None)
+        ns = stamp_ns(header.stamp) if self.use_stamps and header is not None else 0
+        t_s = (ns or self.node.get_clock().now().nanoseconds) * 1e-9
         self.adaptive.observe(value, t_s)
         self._log_events()
 
