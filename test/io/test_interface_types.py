@@ -92,3 +92,14 @@ def test_stamped_commands_are_timed_by_their_stamps_not_the_log(tmp_path):
     lean = read_recording(tmp_path / 'bag', 'flow', topics={
         'command_type': STAMPED_VALUE_TYPE, 'flow_type': STAMPED_VALUE_TYPE})
     np.testing.assert_array_equal(lean.measurement, got.measurement)
+
+
+def test_an_empty_bag_starts_at_zero_and_names_its_distro(tmp_path):
+    import yaml
+
+    with BagWriter(tmp_path / 'bag') as bag:
+        bag.add_topic('/hyst_id/command', STAMPED_VALUE_TYPE)
+    meta = yaml.safe_load((tmp_path / 'bag' / 'metadata.yaml').read_text())
+    info = meta['rosbag2_bagfile_information']
+    assert info['starting_time']['nanoseconds_since_epoch'] == 0      # not INT64_MAX (2262)
+    assert info['ros_distro'] not in ('', 'rosbags') and info['message_count'] == 0

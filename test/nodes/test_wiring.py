@@ -258,3 +258,87 @@ def test_a_float64_command_publisher_is_an_error_at_a_stamped_actuator(ctx):
         io.destroy_node()
     finally:
         other.try_shutdown()
+
+
+def test_kernels_are_warmed_before_traffic_and_before_a_swap(ctx, monkeypatch):
+    """The compensator compiles a set's kernels before it subscribes and before it swaps."""
+    import hyst_id.nodes.compensator as module
+    events = []
+    original = module.warm_up
+
+    def warm(model):
+        events.append(('warm', model.hysteresis[5]))     # c_r
+        original(model)
+
+    monkeypatch.setattr(module, 'warm_up', warm)
+    real_subscribe = Compensator.create_subscription
+
+    def subscribe(self, msg_type, topic, *args, **kwargs):
+        events.append(('subscribe', topic))
+        return real_subscribe(self, msg_type, topic, *args, **kwargs)
+
+    monkeypatch.setattr(Compensator, 'create_subscription', subscribe)
+    comp = make_node(ctx, Compensator, parameter_overrides=[
+        Parameter(k, value=v) for k, v in PAPER.items()])
+    assert events.index(('warm', 0.5)) < events.index(('subscribe', 'hyst_id/desired'))
+    events.clear()
+    swapped = []
+    monkeypatch.setattr(comp._comp, 'set_model',
+                        lambda model, f=comp._comp.set_model: (swapped.append(len(events)),
+                                                               f(model)))
+    assert comp.set_parameters([Parameter('c_r', value=0.6)])[0].successful
+    assert events == [('warm', 0.6)] and swapped == [1]     # compiled, then swapped
+
+
+TWO_GRAPHS = """
+/**/bringup:
+  ros__parameters:
+    channel: {channel}
+    time_scale: 20.0
+    identify_duration_s: 30.0
+    compensate_duration_s: 20.0
+    bag: {bag}
+    settle_s: 0.1
+    timeout_s: 300.0
+/**/identifier:
+  ros__parameters:
+    channel: {channel}
+    generations: 60
+    seeds: 2
+    gate_max_floor_ratio: 0.0
+    gate_max_uncertainty: 0.0
+"""
+
+
+@pytest.mark.slow
+def test_two_whole_graphs_in_two_namespaces_do_not_cross(ros_domain, tmp_path):
+    """Two bringup processes (every node of the graph each) on one domain, /valve1 and /valve2.
+
+    Each bag holds its own namespace's streams only, with exactly its own run's
+    samples (301 + 41 + 41 commands): a topic shared across the namespaces would
+    show the other graph's samples too.
+    """
+    import os
+    import re
+    import subprocess
+    import sys
+
+    from hyst_id.io.bag import open_bag
+
+    procs = {}
+    for valve, channel in (('valve1', 'position'), ('valve2', 'pressure')):
+        params = tmp_path / f'{valve}.yaml'
+        params.write_text(TWO_GRAPHS.format(channel=channel, bag=tmp_path / f'bag_{valve}'))
+        procs[valve] = subprocess.Popen(
+            [sys.executable, '-m', 'hyst_id.nodes.bringup', '--ros-args', '--params-file',
+             str(params), '-r', f'__ns:=/{valve}'],
+            env=dict(os.environ, ROS_HOME=str(tmp_path / valve)), stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT, text=True)
+    outs = {v: p.communicate(timeout=600)[0] for v, p in procs.items()}
+    for valve, proc in procs.items():
+        figures = re.findall(r'(uncompensated|compensated)\s+([0-9.]+) %', outs[valve])
+        assert proc.returncode == 0 and len(figures) == 2, outs[valve][-3000:]
+        with open_bag(tmp_path / f'bag_{valve}') as bag:
+            assert all(t.startswith(f'/{valve}/') for t in bag.topics), bag.topics
+            assert bag.counts[f'/{valve}/hyst_id/command'] == 301 + 41 + 41, bag.counts
+            assert bag.counts[f'/{valve}/hyst_id/desired'] == 41, bag.counts
