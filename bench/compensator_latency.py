@@ -28,7 +28,8 @@
 
 ``bench/compensator_load.py`` adds parameter updates mid-stream (60 s).
 
-Usage: ``python bench/compensator_latency.py [--seconds 5] [--domain 91] [--compute-only]``
+Usage: ``python bench/compensator_latency.py [--seconds 5] [--domain 91] [--compute-only]
+[--stamped]``
 """
 
 from __future__ import annotations
@@ -69,22 +70,26 @@ def compute_times(n: int = 100_000, model: dict | None = None) -> np.ndarray:
     return out
 
 
-def loopback(rate_hz: float, seconds: float, context, ref) -> dict:
+def loopback(rate_hz: float, seconds: float, context, ref, stamped: bool = False) -> dict:
     """Publish desired values at ``rate_hz`` and time the compensated commands.
 
-    ``ref`` is a local Compensator that has seen everything the node has.
+    ``ref`` is a local Compensator that has seen everything the node has;
+    ``stamped``: both streams ``hyst_id_interfaces/msg/StampedValue``.
     """
     from rclpy.executors import SingleThreadedExecutor
     from rclpy.node import Node
-    from std_msgs.msg import Float64
 
-    from hyst_id.nodes.support import COMMAND_QOS, spin_in_background
+    from hyst_id.io.interface_types import FLOAT64_TYPE, STAMPED_VALUE_TYPE
+    from hyst_id.nodes.support import COMMAND_QOS, ScalarStream, spin_in_background
 
+    stream = ScalarStream(STAMPED_VALUE_TYPE if stamped else FLOAT64_TYPE)
     node = Node(f'latency_{int(rate_hz)}', context=context)
-    pub = node.create_publisher(Float64, '/hyst_id/desired', COMMAND_QOS)
+    pub = node.create_publisher(stream.cls, '/hyst_id/desired', COMMAND_QOS)
     recv: list[tuple[int, float]] = []
-    node.create_subscription(Float64, '/hyst_id/command',
-                             lambda m: recv.append((time.monotonic_ns(), m.data)), COMMAND_QOS)
+    node.create_subscription(stream.cls, '/hyst_id/command',
+                             lambda m: recv.append((time.monotonic_ns(), stream.value(m))),
+                             COMMAND_QOS)
+    clock = node.get_clock()
     ex = SingleThreadedExecutor(context=context)
     ex.add_node(node)
     stop_spinning = spin_in_background(ex)
@@ -106,7 +111,7 @@ def loopback(rate_hz: float, seconds: float, context, ref) -> dict:
                 break
             time.sleep(min(due - now, 0.0005))
         sent[k] = time.monotonic_ns()
-        pub.publish(Float64(data=float(desired[k])))
+        pub.publish(stream.make(float(desired[k]), clock.now().to_msg() if stamped else None))
     time.sleep(1.0)
     stop_spinning()
     ex.remove_node(node)
@@ -136,6 +141,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument('--seconds', type=float, default=5.0, help='length of each DDS run')
     parser.add_argument('--domain', type=int, default=91, help='ROS_DOMAIN_ID to use')
     parser.add_argument('--compute-only', action='store_true', help='skip the DDS loopback')
+    parser.add_argument('--stamped', action='store_true',
+                        help='desired and command as hyst_id_interfaces/msg/StampedValue '
+                             '(params/stamped.yaml; needs the interfaces package built)')
     args = parser.parse_args(argv)
 
     print('compute: Compensator.step (H^-1 and B^-1), per sample')
@@ -150,6 +158,9 @@ def main(argv: list[str] | None = None) -> int:
     os.environ['ROS_DOMAIN_ID'] = str(args.domain)
     os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
     overrides = [a for k, v in PAPER.items() for a in ('-p', f'{k}:={v!r}')]
+    if args.stamped:
+        overrides += ['-p', 'topics.desired_type:=hyst_id_interfaces/msg/StampedValue',
+                      '-p', 'topics.command_type:=hyst_id_interfaces/msg/StampedValue']
     import rclpy
 
     from hyst_id.compensation import CommandLimits, Compensator, InverseModel
@@ -164,14 +175,15 @@ def main(argv: list[str] | None = None) -> int:
             try:
                 ref = Compensator(InverseModel.from_mapping(PAPER), CommandLimits(4.0, 20.0),
                                   v0=9.0)
-                rows.append(loopback(rate, args.seconds, context, ref))
+                rows.append(loopback(rate, args.seconds, context, ref, args.stamped))
             finally:
                 comp.send_signal(signal.SIGINT)
                 comp.wait(15)
     finally:
         context.try_shutdown()
     print('\nloopback through DDS: desired -> compensator node -> command '
-          '(separate processes, localhost)')
+          '(separate processes, localhost'
+          + (', StampedValue streams)' if args.stamped else ', Float64 streams)'))
     print(f'  {"rate":>7} {"sent":>6} {"lost":>5} {"median":>9} {"p99":>9} {"max":>9} '
           f'{"unmatched":>9}')
     for r in rows:
