@@ -56,7 +56,9 @@ from hyst_id.diagnosis.mechanisms.base import Context, Mechanism
 from hyst_id.diagnosis.model import ComposedModel, held
 from hyst_id.diagnosis.result import DiagnoseSettings, Diagnosis, Finding
 from hyst_id.diagnosis.select import (
+    alternatives_record,
     choose,
+    close_calls,
     compare,
     Comparison,
     Data,
@@ -251,9 +253,8 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
             break
         mech = next(m for m in mechs if m.id == winner.mechanism)
         findings.append(finding_from(winner, current, mech, loc, ctx, v_orig))
-        findings[-1].alternatives = [{'mechanism': c.mechanism,
-                                      'er_holdout_after_percent': c.fit.er_holdout_percent}
-                                     for c in tied]
+        findings[-1].alternatives = alternatives_record(
+            tied, close_calls(comps, winner, tied, data, settings.criteria))
         current = winner.fit
         loc = locate(t, v_orig, y, current.prediction, sigma, n_train, ctx.period_s)
     _final_corrections(findings, mechs, current, ctx, v_orig)

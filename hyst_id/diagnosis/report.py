@@ -28,6 +28,27 @@ def _fmt(x: float) -> str:
     return f'{x:.4g}' if np.isfinite(x) else 'n/a'
 
 
+def _alts(alternatives: list[dict]) -> str:
+    return ', '.join(f'{a["mechanism"]} (held-out {a["er_holdout_after_percent"]:.4g})'
+                     for a in alternatives)
+
+
+def _alternative_lines(f: Any) -> list[str]:
+    """Lines naming a finding's tied candidates and close calls (judgement calls)."""
+    lines: list[str] = []
+    tied = [a for a in f.alternatives if a.get('kind', 'tied') == 'tied']
+    close = [a for a in f.alternatives if a.get('kind') == 'close']
+    if tied:
+        lines.append('    also consistent with the data (tied, decided by training BIC '
+                     f'and evidence): {_alts(tied)}')
+    if close:
+        lines.append(f'    a judgement call: {_alts(close)} explain it nearly as well '
+                     f'(held-out {_fmt(f.er_holdout_after_percent)} for {f.mechanism}); '
+                     'round-off, the split or a slightly different record could reverse '
+                     'the order')
+    return lines
+
+
 def _params_lines(params: dict) -> list[str]:
     out = []
     for name, q in params.items():
@@ -84,11 +105,7 @@ def format_diagnosis(d: Any) -> str:
                      f'delta BIC {f.delta_bic:.0f}, held-out z {f.holdout_z:.1f}')
         if f.compensation:
             lines.append(f'    compensation: {f.compensation["how"]}')
-        if f.alternatives:
-            alts = ', '.join(f'{a["mechanism"]} (held-out {a["er_holdout_after_percent"]:.4g})'
-                             for a in f.alternatives)
-            lines.append(f'    also consistent with the data (tied, decided by training BIC '
-                         f'and evidence): {alts}')
+        lines += _alternative_lines(f)
         lines.append('')
     if d.findings:
         fin = d.final

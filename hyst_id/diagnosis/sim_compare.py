@@ -56,7 +56,16 @@ from hyst_id.diagnosis.driver import located_where, range_note
 from hyst_id.diagnosis.locate import Localization, locate, noise_std
 from hyst_id.diagnosis.mechanisms import MECHANISMS, Quantity
 from hyst_id.diagnosis.result import DiagnoseSettings, Diagnosis, Finding
-from hyst_id.diagnosis.select import choose, compare, Comparison, Data, FitResult, round_record
+from hyst_id.diagnosis.select import (
+    alternatives_record,
+    choose,
+    close_calls,
+    compare,
+    Comparison,
+    Data,
+    FitResult,
+    round_record,
+)
 from hyst_id.diagnosis.stick_events import bands_from_demand
 from hyst_id.errors import ConfigError, HystIdError, RecordingError
 from hyst_id.identification.chains import er_percent
@@ -350,9 +359,8 @@ def _diagnose_sim(recording, base, settings, say):
         applied[winner.mechanism] = values
         params = params.with_values(values)
         findings.append(_finding(winner, current, loc, values, obj.space))
-        findings[-1].alternatives = [{'mechanism': c.mechanism,
-                                      'er_holdout_after_percent': c.fit.er_holdout_percent}
-                                     for c in tied]
+        findings[-1].alternatives = alternatives_record(
+            tied, close_calls(comps, winner, tied, data, settings.criteria))
         current = winner.fit
         loc = locate(t, v, y, current.prediction, sigma, n_train, period)
     diag = Diagnosis(channel=ch, source=rec.source, mode='sim',

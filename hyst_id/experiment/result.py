@@ -111,14 +111,23 @@ class Calibration:
     b: float
     dynamics: dict = field(default_factory=dict)
     rms_residual: float = 0.0
+    #: ``(centre, scale, (c_2, c_3, ...))``: a static curve ``sum_i c_i z^i`` added,
+    #: ``z = (position - centre) / scale``; empty: a straight line
+    curve: tuple = ()
 
     def to_position(self, reading: np.ndarray) -> np.ndarray:
-        """Readings in position-equivalent units."""
+        """Readings in position-equivalent units (of the straight part ``k``, ``b``)."""
         return (np.asarray(reading, dtype=float) - self.b) / self.k
 
     def from_position(self, position: np.ndarray) -> np.ndarray:
         """Static channel value for positions (the desired trajectory of a channel)."""
-        return self.k * np.asarray(position, dtype=float) + self.b
+        p = np.asarray(position, dtype=float)
+        out = self.k * p + self.b
+        if self.curve:
+            centre, scale, coefs = self.curve
+            z = (p - centre) / scale
+            out = out + sum(c * z ** (i + 2) for i, c in enumerate(coefs))
+        return out
 
 
 @dataclass

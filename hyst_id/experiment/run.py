@@ -73,7 +73,7 @@ from hyst_id.models.tk import loop_corners
 from hyst_id.rig import as_rig_params, RigParams, simulate_rig
 from hyst_id.signals.excitation import eq24, eq25
 
-__all__ = ['run_experiment', 'fit_position_calibration',
+__all__ = ['run_experiment', 'calibration_by_bic', 'fit_position_calibration',
            'to_position_units', 'to_backlash_gauge', 'eps_c_percent', 'ideal_actuator_params']
 
 
@@ -84,7 +84,8 @@ def _lag(channel: str, theta: np.ndarray, position: np.ndarray, t_s: np.ndarray)
 
 
 def fit_position_calibration(channel: str, t_s: np.ndarray, position: np.ndarray,
-                             reading: np.ndarray, gain_law: str = 'none') -> Calibration:
+                             reading: np.ndarray, gain_law: str = 'none',
+                             curve_degree: int = 1) -> Calibration:
     """Fit ``reading = k F(position) + b`` on a run where both were recorded.
 
     ``F`` is ``1/(tau s + 1)`` for pressure and ``w^2/(s^2 + 2 zeta w s + w^2)``
@@ -99,6 +100,10 @@ def fit_position_calibration(channel: str, t_s: np.ndarray, position: np.ndarray
     and the calibration returned holds at the start: ``k, b = b0 + b1``, the
     rate in ``dynamics['gain_rate_per_s']``. With ``'offset'`` (a diagnosed
     ``offset_drift``) it is ``reading = k F + b + rate t``, linear in the rate.
+    ``curve_degree`` > 1 adds ``sum_i c_i F(z^i)``, ``i = 2 .. degree``, ``z``
+    the position centred and scaled on the run (a static curve of the
+    position-to-reading path: an orifice's, a valve characteristic's), kept
+    in ``Calibration.curve``.
 
     Parameters
     ----------
@@ -108,6 +113,8 @@ def fit_position_calibration(channel: str, t_s: np.ndarray, position: np.ndarray
         Sample times, position readings (mA-eq) and the channel's readings.
     gain_law : {'none', 'exponential', 'linear', 'offset'}
         A gain (or an offset) changing over the run.
+    curve_degree : int
+        Degree of the static curve (1: a straight line, the paper's).
 
     Returns
     -------
@@ -124,9 +131,11 @@ def fit_position_calibration(channel: str, t_s: np.ndarray, position: np.ndarray
 
     n_dyn = 1 if channel == 'pressure' else 2
     elapsed = t - t[0]
+    centre, scale = float(np.mean(pos)), float(np.std(pos)) or 1.0
+    powers = [pos] + [((pos - centre) / scale) ** i for i in range(2, int(curve_degree) + 1)]
 
     def solve(theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        f = _lag(channel, theta[:n_dyn], pos, t)
+        f = np.column_stack([_lag(channel, theta[:n_dyn], p, t) for p in powers])
         if gain_law == 'none':
             a = np.column_stack([f, ones])
         elif gain_law == 'offset':
@@ -134,7 +143,7 @@ def fit_position_calibration(channel: str, t_s: np.ndarray, position: np.ndarray
         else:
             r = theta[n_dyn]
             g = np.exp(-r * elapsed) if gain_law == 'exponential' else 1.0 + r * elapsed
-            a = np.column_stack([g * f, g, ones])
+            a = np.column_stack([g[:, None] * f, g, ones])
         kb = np.linalg.lstsq(a, y, rcond=None)[0]
         return kb, y - a @ kb
 
@@ -145,6 +154,8 @@ def fit_position_calibration(channel: str, t_s: np.ndarray, position: np.ndarray
         bounds = ([0.0, 0.01], [0.99, 10.0])
     if gain_law not in ('none', 'exponential', 'linear', 'offset'):
         raise ConfigError(f'unknown gain law {gain_law!r}')
+    if int(curve_degree) < 1:
+        raise ConfigError(f'curve_degree must be >= 1, got {curve_degree!r}')
     if gain_law in ('exponential', 'linear'):
         # rates of -1 .. +1 per run length (linear: the gain stays above 0)
         span = max(float(elapsed[-1]), 1e-9)
@@ -159,14 +170,33 @@ def fit_position_calibration(channel: str, t_s: np.ndarray, position: np.ndarray
     coef, res = solve(best.x)
     names = ('tau_s',) if channel == 'pressure' else ('zeta', 'omega_n')
     dynamics = {n: float(v) for n, v in zip(names, best.x)}
+    m = len(powers)
+    curve = (centre, scale, tuple(float(c) for c in coef[1:m])) if m > 1 else ()
     if gain_law == 'offset':
-        k, b = float(coef[0]), float(coef[1])
-        dynamics.update(gain_law=gain_law, offset_rate_per_s=float(coef[2]))
+        k, b = float(coef[0]), float(coef[m])
+        dynamics.update(gain_law=gain_law, offset_rate_per_s=float(coef[m + 1]))
     else:
-        k, b = float(coef[0]), float(np.sum(coef[1:]))
+        k, b = float(coef[0]), float(np.sum(coef[m:]))
     if gain_law in ('exponential', 'linear'):
         dynamics.update(gain_law=gain_law, gain_rate_per_s=float(best.x[n_dyn]))
-    return Calibration(channel, k, b, dynamics, float(np.sqrt(np.mean(res ** 2))))
+    return Calibration(channel, k, b, dynamics, float(np.sqrt(np.mean(res ** 2))), curve)
+
+
+def calibration_by_bic(channel: str, t_s: np.ndarray, position: np.ndarray,
+                       reading: np.ndarray, gain_law: str = 'none',
+                       max_degree: int = 3) -> Calibration:
+    """:func:`fit_position_calibration` with the static curve's degree chosen by BIC.
+
+    Degrees 1 .. ``max_degree``; ``n ln(mean squared residual) + p ln n``
+    with ``p`` the curve's coefficients: a curve is kept only where the run
+    shows it (on the paper's rig the pressure's orifice curve, not the flow's).
+    """
+    n = len(reading)
+    fits = [fit_position_calibration(channel, t_s, position, reading, gain_law, d)
+            for d in range(1, max_degree + 1)]
+    bic = [n * np.log(max(c.rms_residual, 1e-300) ** 2) + d * np.log(n)
+           for d, c in enumerate(fits, start=1)]
+    return fits[int(np.argmin(bic))]
 
 
 def to_position_units(x: np.ndarray, output_sign: float, cal: Calibration) -> np.ndarray:
@@ -304,7 +334,7 @@ def _adaptive(sc: ScenarioResult, rig: RigParams, config: ExperimentConfig,
             elif law == 'none' and 'augment.offset_rate_per_s' in corr:
                 law = 'offset'
         cal = sc.calibrations[ch] if law == 'none' or ch == 'position' else \
-            fit_position_calibration(ch, run.t_s, run.position, run.measurement(ch), law)
+            calibration_by_bic(ch, run.t_s, run.position, run.measurement(ch), law)
         desired = cal.from_position(sc.uncompensated.command_ma)
         for (mode, c), r in sc.channels.items():
             if c == ch:

@@ -134,7 +134,8 @@ def diagnosis_statuses(doc: dict) -> list[tuple[int, str, str, dict[str, Any]]]:
     its explanation as message and, as values, the mechanism, its place in
     the chain, the held-out and training %e_r before and after adding it,
     its parameters (``name: value unit``) and how the block is compensated
-    (``compensation``: kind, ``compensation_how``: words). No finding gives one level 0
+    (``compensation``: kind, ``compensation_how``: words) and the blocks that
+    explain it nearly as well (``judgement_call``). No finding gives one level 0
     status with the verdict, the held-out %e_r and the noise floor.
     """
     out = []
@@ -157,6 +158,10 @@ def diagnosis_statuses(doc: dict) -> list[tuple[int, str, str, dict[str, Any]]]:
         if comp:
             values['compensation'] = str(comp.get('kind', ''))
             values['compensation_how'] = str(comp.get('how', ''))
+        close = [a['mechanism'] for a in f.get('alternatives') or ()
+                 if isinstance(a, dict) and a.get('kind') == 'close']
+        if close:       # the data barely prefer this block
+            values['judgement_call'] = ', '.join(close)
         message = str(f.get('explanation') or f.get('title') or f.get('mechanism', ''))
         out.append((1, str(f.get('mechanism', '?')), message, values))
     if not out:
