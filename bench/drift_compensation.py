@@ -139,6 +139,33 @@ def run(kind: str, args: argparse.Namespace, first) -> tuple[np.ndarray, np.ndar
     return t, np.array(ys) - want, events
 
 
+def plot_rolling_rms(path: Path, series: dict, swaps: list, xlabel: str, ylabel: str,
+                     title: str, marks: tuple = ()) -> None:
+    """Plot each ``(t, error)`` of ``series`` as its rms over the trailing 10 s.
+
+    ``swaps`` (times of sliding swaps) are dotted lines, ``marks`` solid ones.
+    """
+    import matplotlib
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(8, 3.5))
+    w = int(10.0 / DT_S)            # trailing 10 s: what an operator sees at t
+    for kind, (t, err) in series.items():
+        c = np.concatenate([[0.0], np.cumsum(np.asarray(err) ** 2)])
+        ax.plot(np.asarray(t)[w - 1:], np.sqrt((c[w:] - c[:-w]) / w), label=kind)
+    for tk in swaps:
+        ax.axvline(tk, color='tab:orange', lw=0.6, ls=':')
+    for tk in marks:
+        ax.axvline(tk, color='k', lw=0.6)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
+    ax.legend()
+    fig.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=120)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument('--duration', type=float, default=360.0, help='closed-loop seconds')
@@ -174,26 +201,11 @@ def main() -> None:
     for tk, swap, reason, secs in results['sliding'][2]:
         print(f'- t={tk:.0f} s ({secs:.1f} s): {"SWAP" if swap else "kept"}: {reason}')
     if args.plot:
-        import matplotlib
-        matplotlib.use('Agg')
-        import matplotlib.pyplot as plt
-        fig, ax = plt.subplots(figsize=(8, 3.5))
-        for kind, (t, err, _) in results.items():
-            w = int(10.0 / DT_S)            # trailing 10 s: what an operator sees at t
-            c = np.concatenate([[0.0], np.cumsum(err ** 2)])
-            rms = np.sqrt((c[w:] - c[:-w]) / w)
-            ax.plot(t[w - 1:], rms, label=kind)
-        for tk, swap, _, _ in results['sliding'][2]:
-            if swap:
-                ax.axvline(tk, color='tab:orange', lw=0.6, ls=':')
-        ax.set_xlabel('time [s]')
-        ax.set_ylabel('rms(reading - desired), last 10 s')
-        ax.set_title(f'plant change ({args.profile}): fixed H⁻¹, sliding re-identification, '
-                     'tracking')
-        ax.legend()
-        fig.tight_layout()
-        args.plot.parent.mkdir(parents=True, exist_ok=True)
-        fig.savefig(args.plot, dpi=120)
+        plot_rolling_rms(args.plot, {k: (t, err) for k, (t, err, _) in results.items()},
+                         [tk for tk, swap, _, _ in results['sliding'][2] if swap],
+                         'time [s]', 'rms(reading - desired), last 10 s',
+                         f'plant change ({args.profile}): fixed H⁻¹, sliding '
+                         're-identification, tracking')
         print(f'\nwrote {args.plot}')
 
 

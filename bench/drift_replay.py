@@ -56,7 +56,13 @@ import numpy as np
 sys.path[:0] = [str(Path(__file__).resolve().parent),
                 str(Path(__file__).resolve().parents[1] / 'test')]
 
-from drift_compensation import desired_at, DriftingPlant, DT_S, IDENT_S  # noqa: E402, I100
+from drift_compensation import (  # noqa: E402, I100
+    desired_at,
+    DriftingPlant,
+    DT_S,
+    IDENT_S,
+    plot_rolling_rms,
+)
 
 from hyst_id.compensation.tracking import GainOffsetTracker  # noqa: E402, I100, I202
 from hyst_id.identification import identify, IdentifySettings  # noqa: E402
@@ -148,25 +154,10 @@ def main() -> None:
     for tk, swap, reason in out['events']:
         print(f'- t={tk:.0f} s: {"SWAP" if swap else "kept"}: {reason}')
     if args.plot:
-        import matplotlib
-        matplotlib.use('Agg')
-        import matplotlib.pyplot as plt
-        fig, ax = plt.subplots(figsize=(8, 3.5))
-        w = int(10.0 / DT_S)            # trailing 10 s
-        for kind, err in errors.items():
-            c = np.concatenate([[0.0], np.cumsum(err ** 2)])
-            ax.plot(rec.t_s[w - 1:], np.sqrt((c[w:] - c[:-w]) / w), label=kind)
-        for tk, swap, _ in out['events']:
-            if swap:
-                ax.axvline(tk, color='tab:orange', lw=0.6, ls=':')
-        ax.axvline(IDENT_S, color='k', lw=0.6)
-        ax.set_xlabel('recording time [s]')
-        ax.set_ylabel('rms(reading - model), last 10 s')
-        ax.set_title(f'replayed bag of a drifting plant ({args.profile})')
-        ax.legend()
-        fig.tight_layout()
-        args.plot.parent.mkdir(parents=True, exist_ok=True)
-        fig.savefig(args.plot, dpi=120)
+        plot_rolling_rms(args.plot, {k: (rec.t_s, e) for k, e in errors.items()},
+                         [tk for tk, swap, _ in out['events'] if swap], 'recording time [s]',
+                         'rms(reading - model), last 10 s',
+                         f'replayed bag of a drifting plant ({args.profile})', (IDENT_S,))
         print(f'\nwrote {args.plot}')
 
 

@@ -59,6 +59,24 @@ def _ros2_run(prefixes: list[str], package: str, executable: str) -> Path:
     raise AssertionError(f'package {package} not found in {prefixes}')
 
 
+def _interrupt_once_started(proc: subprocess.Popen) -> tuple[str, str]:
+    """Read the compensator's log until it says it is compensating, then Ctrl-C it.
+
+    Returns what it printed before and after the interrupt.
+    """
+    deadline = time.monotonic() + 30.0
+    seen = ''
+    while time.monotonic() < deadline and 'compensating' not in seen:
+        line = proc.stdout.readline()
+        if not line and proc.poll() is not None:
+            break
+        seen += line
+    assert 'compensating /hyst_id/desired -> /hyst_id/command' in seen, seen
+    proc.send_signal(signal.SIGINT)
+    rest, _ = proc.communicate(timeout=15)
+    return seen, rest
+
+
 @pytest.fixture(scope='module')
 def install(tmp_path_factory):
     tmp = tmp_path_factory.mktemp('colcon')
@@ -97,16 +115,7 @@ def test_installed_compensator_starts_and_exits_0_on_sigint(install, ros_domain)
     proc = subprocess.Popen([str(exe), '--ros-args', '--params-file', str(params)], env=env,
                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     try:
-        deadline = time.monotonic() + 30.0
-        seen = ''
-        while time.monotonic() < deadline and 'compensating' not in seen:
-            line = proc.stdout.readline()
-            if not line and proc.poll() is not None:
-                break
-            seen += line
-        assert 'compensating /hyst_id/desired -> /hyst_id/command' in seen, seen
-        proc.send_signal(signal.SIGINT)
-        rest, _ = proc.communicate(timeout=15)
+        seen, rest = _interrupt_once_started(proc)
         assert proc.returncode == 130, seen + rest   # Ctrl-C
         assert 'Traceback' not in seen + rest
         # the module came from the install space, not the source tree
@@ -148,16 +157,7 @@ def test_installed_interfaces_carry_stamped_streams(install, ros_domain):
                              str(share / 'stamped.yaml')], env=env,
                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     try:
-        deadline = time.monotonic() + 30.0
-        seen = ''
-        while time.monotonic() < deadline and 'compensating' not in seen:
-            line = proc.stdout.readline()
-            if not line and proc.poll() is not None:
-                break
-            seen += line
-        assert 'compensating /hyst_id/desired -> /hyst_id/command' in seen, seen
-        proc.send_signal(signal.SIGINT)
-        rest, _ = proc.communicate(timeout=15)
+        seen, rest = _interrupt_once_started(proc)
         assert proc.returncode == 130, seen + rest
         assert 'desired hyst_id_interfaces/msg/StampedValue; command hyst_id_interfaces/msg/' \
             'StampedValue' in seen, seen

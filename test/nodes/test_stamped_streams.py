@@ -294,36 +294,18 @@ def test_replay_at_rate_4_of_stamped_streams_keeps_tau_without_a_clock(ctx, tmp_
     assert docs[-1]['params']['tau_s'] == pytest.approx(1.5, rel=0.15), docs[-1]['params']
 
 
-BRINGUP = """
-/**/bringup:
-  ros__parameters:
-    channel: flow
-    time_scale: 20.0
-    identify_duration_s: 30.0
-    compensate_duration_s: 20.0
-    bag: {bag}
-    settle_s: 0.1
-    timeout_s: 300.0
-/**/identifier:
-  ros__parameters:
-    channel: flow
-    generations: 60
-    seeds: 2
-    gate_max_floor_ratio: 0.0     # a short run: the wiring is tested, not the fit
-    gate_max_uncertainty: 0.0
-"""
-
-
 @pytest.mark.slow
 def test_bringup_runs_stamped_streams_in_a_namespace(ros_domain, tmp_path, monkeypatch, capfd):
     """The whole graph with params/stamped.yaml, on flow, under -r __ns:=/valve1."""
     import re
 
+    from test_wiring import TWO_GRAPHS   # the short bringup of the two-namespace test
+
     from hyst_id.nodes import bringup
 
     monkeypatch.setenv('ROS_HOME', str(tmp_path / 'ros_home'))
     params = tmp_path / 'bringup.yaml'
-    params.write_text(BRINGUP.format(bag=tmp_path / 'bag'))
+    params.write_text(TWO_GRAPHS.format(channel='flow', bag=tmp_path / 'bag'))
     stamped = Path(__file__).resolve().parents[2] / 'params' / 'stamped.yaml'
     code = bringup.main(['--ros-args', '--params-file', str(params), '--params-file',
                          str(stamped), '-r', '__ns:=/valve1'])

@@ -290,6 +290,7 @@ def test_kernels_are_warmed_before_traffic_and_before_a_swap(ctx, monkeypatch):
     assert events == [('warm', 0.6)] and swapped == [1]     # compiled, then swapped
 
 
+#: A short bringup (every node, one channel) whose wiring, not fit, is tested.
 TWO_GRAPHS = """
 /**/bringup:
   ros__parameters:
