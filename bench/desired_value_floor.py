@@ -28,8 +28,9 @@ richness, all fitted on the identification run by variable projection:
 
 * ``linear``: ``k F(position) + b`` (the paper's procedure; ``F`` the
   channel's sensor lag: first order for pressure, second order for flow);
-* ``+ gain law``: times an exponential gain from the run's start, referred to
-  the start (what column (b) uses when the diagnosis finds a drift);
+* ``+ gain law``: times a linear gain ``1 + r t`` from the run's start,
+  referred to the start (what column (b) uses for the ``gain_drift`` the
+  diagnosis finds on this run);
 * ``+ polynomial``: a cubic of the position instead of ``k position``;
 * ``+ lead``: a first-order high-pass of the position added (the pipe
   emptying when the valve opens: flow overshoots).
@@ -64,7 +65,7 @@ def lag(channel: str, theta, x: np.ndarray, t: np.ndarray) -> np.ndarray:
 
 def fit(channel: str, t: np.ndarray, pos: np.ndarray, y: np.ndarray, degree: int,
         gain_law: bool, lead: bool):
-    """Fit ``y = g(t) (sum_i a_i F(p^i) + a_l F(hp(p)) + b0) + b1`` (``g = 1``: one offset).
+    """Fit ``y = g(t) (sum_i a_i F(p^i) + a_l F(hp(p)) + b0) + b1`` (no law: one offset).
 
     Returns the lag (and rate, lead) parameters, the linear coefficients, the
     position's centre and scale, and the rms residual.
@@ -81,7 +82,7 @@ def fit(channel: str, t: np.ndarray, pos: np.ndarray, y: np.ndarray, degree: int
                           pos - simulate_first_order(pos, t, theta[n_lag + 1]), t))
         if not gain_law:
             return np.column_stack(fs + [np.ones_like(t)])
-        g = np.exp(-theta[n_lag] * (t - t[0]))
+        g = 1.0 + theta[n_lag] * (t - t[0])       # linear, as (b) uses for gain_drift
         return np.column_stack([g[:, None] * np.column_stack(fs), g, np.ones_like(t)])
 
     def residual(theta):
@@ -89,7 +90,7 @@ def fit(channel: str, t: np.ndarray, pos: np.ndarray, y: np.ndarray, degree: int
         return y - a @ np.linalg.lstsq(a, y, rcond=None)[0]
 
     rate = 1.0 / span if gain_law else 1e-12     # without a gain law the rate is unused
-    lo = list(BOUNDS[channel][0]) + [-rate] + ([0.05] if lead else [])
+    lo = list(BOUNDS[channel][0]) + [-0.99 * rate] + ([0.05] if lead else [])
     hi = list(BOUNDS[channel][1]) + [rate] + ([200.0] if lead else [])
     best = None
     for start in LAGS[channel]:

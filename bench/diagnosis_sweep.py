@@ -93,7 +93,8 @@ def run_one(job: tuple) -> dict:
     d = diagnose(run.recording(channel), settings=DiagnoseSettings(workers=1))
     return {'truth': truth, 'channel': channel, 'level': level, 'magnitude': magnitude,
             'seed': seed, 'verdict': d.verdict, 'final': list(d.final.ids),
-            'alternatives': [a['mechanism'] for a in d.findings[0].alternatives]
+            'alternatives': [a['mechanism'] for a in d.findings[0].alternatives
+                             if a.get('kind', 'tied') == 'tied']
             if d.findings else [],
             'er_holdout_before': d.baseline.er_holdout_percent,
             'er_holdout_after': d.final.er_holdout_percent,

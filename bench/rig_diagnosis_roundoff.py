@@ -42,7 +42,8 @@ t = np.arange(0.0, 100.0, 0.05)
 run = simulate_rig(rig, t, eq24(t), seed=0)
 d = diagnose(run.recording(%r), settings=DiagnoseSettings(max_mechanisms=3))
 print(d.verdict, [f.mechanism for f in d.findings], round(d.final.er_holdout_percent, 4),
-      [[a['mechanism'] for a in f.alternatives] for f in d.findings])
+      [[f"{a['mechanism']} ({a.get('kind', 'tied')})" for a in f.alternatives]
+       for f in d.findings])
 """
 
 

@@ -254,7 +254,7 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
         mech = next(m for m in mechs if m.id == winner.mechanism)
         findings.append(finding_from(winner, current, mech, loc, ctx, v_orig))
         findings[-1].alternatives = alternatives_record(
-            tied, close_calls(comps, winner, tied, data, settings.criteria))
+            tied, close_calls(comps, winner, tied, data, settings.criteria), data)
         current = winner.fit
         loc = locate(t, v_orig, y, current.prediction, sigma, n_train, ctx.period_s)
     _final_corrections(findings, mechs, current, ctx, v_orig)

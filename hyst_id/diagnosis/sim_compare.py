@@ -360,7 +360,7 @@ def _diagnose_sim(recording, base, settings, say):
         params = params.with_values(values)
         findings.append(_finding(winner, current, loc, values, obj.space))
         findings[-1].alternatives = alternatives_record(
-            tied, close_calls(comps, winner, tied, data, settings.criteria))
+            tied, close_calls(comps, winner, tied, data, settings.criteria), data)
         current = winner.fit
         loc = locate(t, v, y, current.prediction, sigma, n_train, period)
     diag = Diagnosis(channel=ch, source=rec.source, mode='sim',

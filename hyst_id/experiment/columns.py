@@ -28,8 +28,9 @@ identification run and with no simulator truth:
     did, so a schedule fitted from its start applies; where the diagnosis
     found a gain changing in time, the desired value comes from a position
     calibration fitted with that gain and referred to the run's start
-    (:func:`~hyst_id.experiment.run.fit_position_calibration` with
-    ``gain_law``): the supply level the regulated reference holds.
+    (:func:`~hyst_id.experiment.run.calibration_by_bic` with ``gain_law``; a
+    static curve of degree 1-3 where the run shows one): the supply level the
+    regulated reference holds.
 (c) **tracking**: the identified set in an
     :class:`~hyst_id.compensation.tracking.AdaptiveCompensator` (gain and
     offset by recursive least squares, forgetting ``forget_time_s``), closed
@@ -90,7 +91,12 @@ class AdaptiveColumns:
                 'floor_percent': {'a': self.floor_percent[0], 'b': self.floor_percent[1]},
                 'calibration': None if self.calibration is None else {
                     'k': self.calibration.k, 'b': self.calibration.b,
-                    **self.calibration.dynamics}}
+                    **self.calibration.dynamics,
+                    'rms_residual': self.calibration.rms_residual,
+                    'curve': None if not self.calibration.curve else {
+                        'centre': self.calibration.curve[0],
+                        'scale': self.calibration.curve[1],
+                        'coefficients': list(self.calibration.curve[2])}}}
 
 
 def diagnose_channel(recording: Any, settings: DiagnoseSettings) -> Any:

@@ -33,8 +33,7 @@ from hyst_id.io.params_file import read_yaml
 from hyst_id.io.recording import CHANNELS
 
 __all__ = ['NamedIndex', 'NODE_STREAM_KEYS', 'TOPIC_FILE_KEYS', 'TopicConfig', 'get_field',
-           'load_topic_config',
-           'parse_field_path']
+           'load_topic_config', 'parse_field_path', 'value_field']
 
 #: Per channel: topic, message type, field path, unit.
 _COMMAND_DEFAULTS = ('/hyst_id/command', 'std_msgs/msg/Float64', 'data', 'mA')
@@ -62,6 +61,11 @@ class NamedIndex(str):
     the indexed field (``sensor_msgs/JointState``'s joint names), so a
     recording reads the right joint whatever the order the driver publishes.
     """
+
+
+def value_field(type_name: str, field: str) -> str:
+    """``field``, or ``value`` for a ``StampedValue`` left at Float64's default ``data``."""
+    return 'value' if type_name == STAMPED_VALUE_TYPE and field == 'data' else field
 
 
 def parse_field_path(path: str) -> tuple[str | int, ...]:

@@ -196,6 +196,11 @@ class ActuatorDriver(HystNode):
         ns = stamp_ns(stamp) if stamp is not None else (
             int(info.get('received_timestamp') or 0) or self.get_clock().now().nanoseconds)
         dt_s = 0.0 if self._last_ns is None else (ns - self._last_ns) * 1e-9
+        if dt_s < 0.0:      # a stale or replayed-again stamp: no time passes, none goes back
+            self.get_logger().warning(f'command stamped {-dt_s:.3g} s before the previous '
+                                      'one: applied with no time elapsed',
+                                      throttle_duration_sec=5.0)
+            dt_s, ns = 0.0, self._last_ns
         self._last_ns = ns
         command = self._command.value(msg)
         if not math.isfinite(command):

@@ -58,7 +58,7 @@ from rclpy.task import Future
 
 from hyst_id.errors import HystIdError
 from hyst_id.io.recording import CHANNELS
-from hyst_id.io.topics import get_field, parse_field_path
+from hyst_id.io.topics import get_field, parse_field_path, value_field
 from hyst_id.live.buffer import SampleBuffer
 from hyst_id.nodes.actuator_driver import ActuatorDriver
 from hyst_id.nodes.compensator import Compensator
@@ -208,7 +208,8 @@ class Bringup(HystNode):
         self._periods = {'identify': v['identify_sample_period_s'],
                          'compensate': v['compensate_sample_period_s']}
         self.pipeline.set_parameters([Parameter('step_s', value=self._periods['identify'])])
-        self._field = parse_field_path(self.identifier.p(f'topics.{ch}_field'))
+        self._field = parse_field_path(value_field(self.identifier.p(f'topics.{ch}_type'),
+                                                   self.identifier.p(f'topics.{ch}_field')))
         self._buffers = {'uncompensated': SampleBuffer(), 'compensated': SampleBuffer()}
         self._phase = 'start'
         self._phase_t = time.monotonic()

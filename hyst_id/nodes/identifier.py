@@ -52,7 +52,7 @@ from hyst_id.identification import Identification, IdentifySettings
 from hyst_id.identification.config import make_settings, make_spec
 from hyst_id.identification.model_choice import AUTO_FAMILIES
 from hyst_id.io.recording import Recording, validate_recording
-from hyst_id.io.topics import get_field, parse_field_path, TopicConfig
+from hyst_id.io.topics import get_field, parse_field_path, TopicConfig, value_field
 from hyst_id.live import (
     diagnosis_statuses,
     DiagnosisJob,
@@ -108,11 +108,11 @@ class Identifier(HystNode):
         self.job: IdentificationJob | None = None
         self.diag_job: DiagnosisJob | None = None
         self.last_identification: Identification | None = None
-        #: The last set handed over (params file, compensator): what sliding refits.
-        self.handed_over: Identification | None = None
+        self.handed_over: Identification | None = None   # the set sliding refits
         self.last_document: dict | None = None
         self.last_diagnosis: dict | None = None
-        self.last_error, self._eor_tried, self._requested = '', False, set()
+        self.last_error = self._gate_message = ''
+        self._eor_tried, self._requested = False, set()
         self.on_identified: Callable[[dict], None] | None = None
         self._cancelled: list[IdentificationJob | DiagnosisJob] = []
         self._last_rec: Recording | None = None
@@ -120,13 +120,13 @@ class Identifier(HystNode):
         self._pusher = ParameterPusher(self)
         self.sliding = SlidingLink(self)
         self._started = time.monotonic()
-        #: monotonic time each input stream was last received (not reset by a new run).
-        self._rx: dict[str, float] = {}
-        self._gate_message = ''
-        self._cmd_field = parse_field_path(v['topics.command_field'])
-        self._meas_field = parse_field_path(v[f'topics.{self.channel}_field'])
-        self._meas_topic = v[f'topics.{self.channel}_topic']
+        self._rx: dict[str, float] = {}     # monotonic time each input was last received
         meas_type = v[f'topics.{self.channel}_type']
+        self._cmd_field = parse_field_path(value_field(v['topics.command_type'], v[
+            'topics.command_field']))
+        self._meas_field = parse_field_path(value_field(meas_type,
+                                                        v[f'topics.{self.channel}_field']))
+        self._meas_topic = v[f'topics.{self.channel}_topic']
         self._expected = ((v['topics.command_topic'], v['topics.command_type']),
                           (self._meas_topic, meas_type))
         cmd_cls, meas_cls = ScalarStream(v['topics.command_type']).cls, message_class(meas_type)

@@ -276,6 +276,11 @@ class PipelineSim(HystNode):
         ns = stamp_ns(cmd_stamp) if cmd_stamp is not None else (
             int(info.get('received_timestamp') or 0) or self.get_clock().now().nanoseconds)
         dt_s = 0.0 if self._last_ns is None else (ns - self._last_ns) * 1e-9
+        if dt_s < 0.0:      # a stale or replayed-again stamp: no time passes, none goes back
+            self.get_logger().warning(f'command stamped {-dt_s:.3g} s before the previous '
+                                      'one: applied with no time elapsed',
+                                      throttle_duration_sec=5.0)
+            dt_s, ns = 0.0, self._last_ns
         self._last_ns = ns
         step_s = self.p('step_s')
         reading = self.plant.step(command, step_s if step_s > 0 else dt_s * self.p('time_scale'))

@@ -69,9 +69,10 @@ def test_runners_up_within_the_ratio_are_close_calls():
     close = close_calls(comps, winner, tied, data, crit)
     assert [c.mechanism for c in close] == ['gain_drift']       # not 40 %, not rejected
     assert close_calls(comps, None, [], data, crit) == []
-    record = alternatives_record(tied, close)
-    assert record == [{'mechanism': 'gain_drift', 'er_holdout_after_percent': 1.12,
-                       'kind': 'close'}]
+    record = alternatives_record(tied, close, data)
+    assert [(r['mechanism'], r['kind'], r['er_holdout_after_percent']) for r in record] == [
+        ('gain_drift', 'close', 1.12)]
+    assert record[0]['er_judged_after_percent'] == data.judged_er_percent(close[0].fit)
     wide = Criteria(judgement_ratio=1.5)
     assert {c.mechanism for c in close_calls(comps, winner, tied, data, wide)} == {
         'gain_drift', 'static_nonlinearity'}
@@ -84,9 +85,20 @@ def test_the_report_names_the_close_call():
     winner, tied = choose(comps, data, crit)
     finding = SimpleNamespace(mechanism='offset_drift', er_holdout_after_percent=1.0,
                               alternatives=alternatives_record(
-                                  tied, close_calls(comps, winner, tied, data, crit)))
+                                  tied, close_calls(comps, winner, tied, data, crit), data))
     text = '\n'.join(_alternative_lines(finding))
     assert 'a judgement call: gain_drift (held-out 1.12) explain it nearly as well' in text
     assert 'also consistent' not in text
-    finding.alternatives = alternatives_record([comps[1]], [])      # a tie instead
+    finding.alternatives = alternatives_record([comps[1]], [], data)      # a tie instead
     assert 'also consistent with the data' in '\n'.join(_alternative_lines(finding))
+
+
+def test_diagnostics_carry_the_judgement_call():
+    from hyst_id.live.documents import diagnosis_statuses
+
+    doc = {'verdict': 'offset_drift', 'findings': [{
+        'mechanism': 'offset_drift', 'explanation': 'the offset moves',
+        'alternatives': [{'mechanism': 'gain_drift', 'kind': 'close'},
+                         {'mechanism': 'supply_decay', 'kind': 'tied'}]}]}
+    (level, name, _, values), = diagnosis_statuses(doc)
+    assert (level, name, values['judgement_call']) == (1, 'offset_drift', 'gain_drift')

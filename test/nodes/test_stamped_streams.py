@@ -221,8 +221,12 @@ def test_identifier_times_a_burst_of_stamped_samples_by_their_stamps(ctx):
 
 
 def test_a_field_the_type_lacks_is_refused_with_the_fields(ctx):
-    with pytest.raises(ConfigError, match=r"command_field.*no field 'data'.*header, value"):
-        Identifier(context=ctx[0], parameter_overrides=FAST + STAMPED[:1])
+    wrong = [STAMPED[0], Parameter('topics.command_field', value='position[0]')]
+    with pytest.raises(ConfigError, match=r"command_field.*no field 'position'.*header, value"):
+        Identifier(context=ctx[0], parameter_overrides=FAST + wrong)
+    # the type alone is enough: Float64's default field 'data' reads a StampedValue's value
+    ident = make_node(ctx, Identifier, parameter_overrides=FAST + STAMPED[:1])
+    assert ident._cmd_field == ('value',)
 
 
 def test_identifier_publishes_the_typed_result_beside_the_json(ctx):

@@ -236,10 +236,13 @@ def test_the_last_sets_warnings_stay_on_diagnostics(ctx):
     statuses = _statuses(ctx)
     ident = make_node(ctx, Identifier, parameter_overrides=FAST)
     ident.last_document = {'er_percent': 0.5, 'warnings': ['c_t is not identifiable']}
-    seen = []
-    assert _spin_until(ctx, lambda: len(seen.extend(
-        s for s in statuses if s[0] == 'hyst_id: identifier') or seen) >= 3, timeout=10.0)
-    assert all(lvl == 1 and 'c_t is not identifiable' in m for _, lvl, m in seen[-3:]), seen
+
+    def mine():
+        return [s for s in statuses if s[0] == 'hyst_id: identifier']
+
+    # three 1 Hz status ticks (over two seconds), every one of them WARN with the warning
+    assert _spin_until(ctx, lambda: len(mine()) >= 3, timeout=10.0), statuses
+    assert all(lvl == 1 and 'c_t is not identifiable' in m for _, lvl, m in mine()), mine()
 
 
 def test_a_float64_command_publisher_is_an_error_at_a_stamped_actuator(ctx):

@@ -33,7 +33,7 @@ from hyst_id.compensation import Compensator as CoreCompensator
 from hyst_id.compensation.tracking import (AdaptiveCompensator, GainOffsetTracker,
                                            SensorPredictor)
 from hyst_id.errors import ConfigError, InvalidParametersError
-from hyst_id.io.topics import get_field, parse_field_path
+from hyst_id.io.topics import get_field, parse_field_path, value_field
 from hyst_id.nodes.support.params import Param
 from hyst_id.nodes.support.qos import OVERRIDABLE
 from hyst_id.nodes.support.ros import check_field, message_class, stamp_ns
@@ -107,7 +107,8 @@ class TrackingLink:
             sensor_predictor(values)
             channel = values['channel']
             check_field(message_class(values[f'topics.{channel}_type']),
-                        parse_field_path(values[f'topics.{channel}_field']),
+                        parse_field_path(value_field(values[f'topics.{channel}_type'],
+                                                     values[f'topics.{channel}_field'])),
                         f'topics.{channel}_field')
         except (InvalidParametersError, ConfigError) as exc:
             return f'tracking: {exc}'
@@ -131,7 +132,8 @@ class TrackingLink:
         if self._sub is None:
             self._channel = channel
             topic = values[f'topics.{channel}_topic']
-            self._field = parse_field_path(values[f'topics.{channel}_field'])
+            self._field = parse_field_path(value_field(values[f'topics.{channel}_type'],
+                                                       values[f'topics.{channel}_field']))
             qos = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=50,
                              reliability=ReliabilityPolicy.BEST_EFFORT)
             self._sub = self.node.create_subscription(
