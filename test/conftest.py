@@ -16,6 +16,8 @@
 
 from __future__ import annotations
 
+import contextlib
+
 import itertools
 import os
 import time
@@ -121,3 +123,23 @@ def spin_nodes_until(context, nodes, predicate, timeout=10.0) -> bool:
         for n in nodes:
             ex.remove_node(n)
         ex.shutdown()
+
+
+@contextlib.contextmanager
+def other_participant(name: str = 'io'):
+    """A node in a context of its own: another DDS participant, as another process would be.
+
+    One participant cannot hold two types on one topic; a publisher of a wrong
+    type has to come from elsewhere.
+    """
+    import rclpy
+    from rclpy.node import Node
+
+    other = rclpy.Context()
+    rclpy.init(context=other)
+    node = Node(name, context=other)
+    try:
+        yield node
+    finally:
+        node.destroy_node()
+        other.try_shutdown()

@@ -36,7 +36,7 @@ import copy
 import json
 from pathlib import Path
 
-from conftest import make_node, spin_nodes_until
+from conftest import make_node, other_participant, spin_nodes_until
 import numpy as np
 import pytest
 
@@ -117,17 +117,11 @@ def test_a_float64_publisher_on_a_stamped_desired_topic_is_an_error(ctx):
     make_node(ctx, Compensator, parameter_overrides=[
         Parameter('topics.desired_type', value=STAMPED_VALUE_TYPE),
         Parameter('diagnostics_period_s', value=0.2)])
-    other = rclpy.Context()            # another participant, as another process would be
-    rclpy.init(context=other)
-    try:
-        io = Node('io', context=other)
+    with other_participant() as io:   # a wrong type can only come from elsewhere
         io.create_publisher(Float64, 'hyst_id/desired', COMMAND_QOS)
         assert _spin_until(ctx, lambda: any(
             n == 'hyst_id: compensator' and lvl == 2 and 'std_msgs/msg/Float64' in m
             and STAMPED_VALUE_TYPE in m for n, lvl, m in statuses), timeout=10.0), statuses
-        io.destroy_node()
-    finally:
-        other.try_shutdown()
 
 
 def test_actuator_driver_stamps_the_position_with_the_command_stamp(ctx):

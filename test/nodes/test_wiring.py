@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import json
 
-from conftest import make_node, spin_nodes_until
+from conftest import make_node, other_participant, spin_nodes_until
 import pytest
 
 rclpy = pytest.importorskip('rclpy')
@@ -177,17 +177,11 @@ def test_a_wrong_message_type_on_the_desired_topic_is_an_error(ctx):
     statuses = _statuses(ctx)
     make_node(ctx, Compensator, parameter_overrides=[
         Parameter('diagnostics_period_s', value=0.2)])
-    other = rclpy.Context()            # another participant, as another process would be
-    rclpy.init(context=other)
-    try:
-        io = Node('io', context=other)
+    with other_participant() as io:   # a wrong type can only come from elsewhere
         io.create_publisher(String, 'hyst_id/desired', LATCHED_QOS)
         assert _spin_until(ctx, lambda: any(n == 'hyst_id: compensator' and lvl == 2
                                             and 'std_msgs/msg/String' in m
                                             for n, lvl, m in statuses), timeout=10.0)
-        io.destroy_node()
-    finally:
-        other.try_shutdown()
 
 
 def test_commands_without_measurements_are_an_error(ctx):
@@ -250,17 +244,11 @@ def test_a_float64_command_publisher_is_an_error_at_a_stamped_actuator(ctx):
     from hyst_id.nodes.actuator_driver import ActuatorDriver
     make_node(ctx, ActuatorDriver, parameter_overrides=[
         Parameter('topics.command_type', value='hyst_id_interfaces/msg/StampedValue')])
-    other = rclpy.Context()            # another participant, as another process would be
-    rclpy.init(context=other)
-    try:
-        io = Node('io', context=other)
+    with other_participant() as io:   # a wrong type can only come from elsewhere
         io.create_publisher(Float64, 'hyst_id/command', COMMAND_QOS)
         assert _spin_until(ctx, lambda: any(
             n == 'hyst_id: actuator_driver' and lvl == 2 and 'std_msgs/msg/Float64' in m
             for n, lvl, m in statuses), timeout=10.0), statuses
-        io.destroy_node()
-    finally:
-        other.try_shutdown()
 
 
 def test_kernels_are_warmed_before_traffic_and_before_a_swap(ctx, monkeypatch):
