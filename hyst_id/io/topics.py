@@ -180,7 +180,7 @@ class TopicConfig:
             ``<channel>_topic``, ``<channel>_type``, ``<channel>_field``,
             ``<channel>_unit`` (keys of other channels are ignored) and
             ``stamp_source``. A ``*_type`` of ``hyst_id_interfaces/msg/StampedValue``
-            without its ``*_field`` reads ``value``.
+            whose field is left at ``data`` reads ``value`` (:func:`value_field`).
 
         Raises
         ------
@@ -199,9 +199,7 @@ class TopicConfig:
                                       ('measurement', channel, defaults)):
             for i, suffix in enumerate(_SUFFIXES):
                 values[f'{role}_{suffix}'] = params.get(f'{prefix}_{suffix}', default[i])
-            if params.get(f'{prefix}_type') == STAMPED_VALUE_TYPE \
-                    and f'{prefix}_field' not in params:
-                values[f'{role}_field'] = 'value'       # a stamped scalar's value
+            values[f'{role}_field'] = value_field(values[f'{role}_type'], values[f'{role}_field'])
         values['stamp_source'] = params.get('stamp_source', 'header')
         return cls(**values)
 

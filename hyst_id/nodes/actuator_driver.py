@@ -43,6 +43,7 @@ from hyst_id.models.backlash import backlash_step, check_backlash
 from hyst_id.models.tk import check_hysteresis, hysteresis_step, initial_output
 from hyst_id.nodes.support import (
     COMMAND_QOS,
+    CommandClock,
     HystNode,
     OVERRIDABLE,
     Param,
@@ -50,7 +51,6 @@ from hyst_id.nodes.support import (
     ScalarStream,
     SENSOR_QOS,
     spin_node,
-    stamp_ns,
     topic_params,
 )
 
@@ -160,7 +160,7 @@ class ActuatorDriver(HystNode):
                                          {n: values[n] for n in _B_NAMES},
                                          values['noise_std'], values['seed'])
         self.actuator = actuator
-        self._last_ns: int | None = None
+        self._command_clock = CommandClock()
         self._n = 0
         self._pub = self.create_publisher(JointState, self.p('topics.position_topic'),
                                           SENSOR_QOS, qos_overriding_options=OVERRIDABLE)
@@ -192,16 +192,8 @@ class ActuatorDriver(HystNode):
         # command acts (a stamped command's stamp; else when it arrived: the middleware's
         # receive stamp, free of executor delays) until the next command, so that is the
         # sample's stamp.
-        stamp = self._command.stamp(msg)
-        ns = stamp_ns(stamp) if stamp is not None else (
-            int(info.get('received_timestamp') or 0) or self.get_clock().now().nanoseconds)
-        dt_s = 0.0 if self._last_ns is None else (ns - self._last_ns) * 1e-9
-        if dt_s < 0.0:      # a stale or replayed-again stamp: no time passes, none goes back
-            self.get_logger().warning(f'command stamped {-dt_s:.3g} s before the previous '
-                                      'one: applied with no time elapsed',
-                                      throttle_duration_sec=5.0)
-            dt_s, ns = 0.0, self._last_ns
-        self._last_ns = ns
+        ns, dt_s = self._command_clock.advance(self._command.acts_at_ns(msg, info, self),
+                                               self.get_logger())
         command = self._command.value(msg)
         if not math.isfinite(command):
             self.get_logger().warning('ignored a non-finite command', throttle_duration_sec=5.0)

@@ -353,11 +353,14 @@ class Compensator(HystNode):
     # ------------------------------------------------------------- callbacks
     def _on_desired(self, msg: Any) -> None:
         # a stamped desired value acts at its stamp (schedules run on it, the command
-        # carries it); an unstamped one now
+        # carries it); an unstamped one now (a message of it only for a stamped command)
         stamp = self._desired.stamp(msg)
         if stamp is None:
-            stamp = self.get_clock().now().to_msg()
-        t_s = stamp_ns(stamp) * 1e-9
+            now = self.get_clock().now()
+            t_s = now.nanoseconds * 1e-9
+            stamp = now.to_msg() if self._command.stamped else None
+        else:
+            t_s = stamp_ns(stamp) * 1e-9
         desired = self._desired.value(msg)
         t0 = time.perf_counter_ns()
         if self._comp.model is None and self.p('require_model'):

@@ -235,7 +235,8 @@ class Excitation(HystNode):
         if self.ready is not None and not self.ready(self._k):
             return
         t_s = self._k * self.p('sample_period_s')
-        sample = self._out.make(self._profile(t_s), self.get_clock().now().to_msg())
+        sample = self._out.make(self._profile(t_s), self.get_clock().now().to_msg()
+                                if self._out.stamped else None)
         if not try_publish(self._pub, sample):
             self.get_logger().warning(f'sample {self._k} refused by the middleware (a '
                                       'subscriber stalled?): retrying it on the next tick',

@@ -62,6 +62,7 @@ from hyst_id.nodes.actuator_driver import (actuator_problem, PAPER_BACKLASH, PAP
                                            SimulatedActuator)
 from hyst_id.nodes.support import (
     COMMAND_QOS,
+    CommandClock,
     HystNode,
     OVERRIDABLE,
     Param,
@@ -69,7 +70,6 @@ from hyst_id.nodes.support import (
     ScalarStream,
     SENSOR_QOS,
     spin_node,
-    stamp_ns,
     topic_params,
 )
 
@@ -241,7 +241,7 @@ class PipelineSim(HystNode):
         super().__init__('pipeline_sim', PARAMS, **kwargs)
         values = self.param_values()
         self.plant = plant if plant is not None else make_plant(values)
-        self._last_ns: int | None = None
+        self._command_clock = CommandClock()
         self._pres_pub = self.create_publisher(FluidPressure, values['topics.pressure_topic'],
                                                SENSOR_QOS, qos_overriding_options=OVERRIDABLE)
         self._command = ScalarStream(values['topics.command_type'])
@@ -272,16 +272,8 @@ class PipelineSim(HystNode):
             self.get_logger().warning('ignored a non-finite command', throttle_duration_sec=5.0)
             return
         # a stamped command acts at its stamp; an unstamped one when it arrived
-        cmd_stamp = self._command.stamp(msg)
-        ns = stamp_ns(cmd_stamp) if cmd_stamp is not None else (
-            int(info.get('received_timestamp') or 0) or self.get_clock().now().nanoseconds)
-        dt_s = 0.0 if self._last_ns is None else (ns - self._last_ns) * 1e-9
-        if dt_s < 0.0:      # a stale or replayed-again stamp: no time passes, none goes back
-            self.get_logger().warning(f'command stamped {-dt_s:.3g} s before the previous '
-                                      'one: applied with no time elapsed',
-                                      throttle_duration_sec=5.0)
-            dt_s, ns = 0.0, self._last_ns
-        self._last_ns = ns
+        ns, dt_s = self._command_clock.advance(self._command.acts_at_ns(msg, info, self),
+                                               self.get_logger())
         step_s = self.p('step_s')
         reading = self.plant.step(command, step_s if step_s > 0 else dt_s * self.p('time_scale'))
         stamp = Time()

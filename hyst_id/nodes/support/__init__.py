@@ -54,11 +54,11 @@ from hyst_id.nodes.support.ros import (
                                        try_publish,
                                        type_mismatches,
 )
-from hyst_id.nodes.support.scalar import ScalarStream
+from hyst_id.nodes.support.scalar import CommandClock, ScalarStream
 
 __all__ = [
-    'COMMAND_QOS', 'DESIRED_TOPIC', 'check_field', 'DIAGNOSTICS_QOS', 'DIAGNOSTICS_TOPIC',
-    'EXIT_SIGINT',
+    'COMMAND_QOS', 'CommandClock', 'DESIRED_TOPIC', 'check_field', 'DIAGNOSTICS_QOS',
+    'DIAGNOSTICS_TOPIC', 'EXIT_SIGINT',
     'IDENTIFIED_PARAMS_TOPIC', 'LATCHED_QOS', 'OVERRIDABLE', 'SENSOR_QOS', 'TOPIC_KEYS',
     'diagnostic_array', 'exit_code_after', 'field_params', 'HystNode', 'init_ros',
     'input_problems',

@@ -26,13 +26,13 @@ value stands for, so replays, queues and clocks do not move it). A
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Mapping
 
 from hyst_id.errors import ConfigError
 from hyst_id.io.interface_types import FLOAT64_TYPE, SCALAR_TYPES, STAMPED_VALUE_TYPE
 from hyst_id.nodes.support.ros import message_class, stamp_ns
 
-__all__ = ['ScalarStream']
+__all__ = ['CommandClock', 'ScalarStream']
 
 
 @dataclass(frozen=True)
@@ -66,11 +66,6 @@ class ScalarStream:
         """Whether the messages carry a header stamp."""
         return self.type_name == STAMPED_VALUE_TYPE
 
-    @property
-    def value_field(self) -> str:
-        """The field path of the value (``data`` or ``value``)."""
-        return 'value' if self.stamped else 'data'
-
     def make(self, value: float, stamp: Any = None) -> Any:
         """A message holding ``value``; ``stamp`` (``builtin_interfaces/Time``) if stamped."""
         if not self.stamped:
@@ -92,3 +87,35 @@ class ScalarStream:
         if header is None or not stamp_ns(header.stamp):
             return None
         return header.stamp
+
+    def acts_at_ns(self, msg: Any, info: Mapping[str, Any], node: Any) -> int:
+        """When a command takes effect (ns): its stamp, else when it arrived.
+
+        The middleware's receive timestamp (free of executor delays), else now.
+        """
+        stamp = self.stamp(msg)
+        if stamp is not None:
+            return stamp_ns(stamp)
+        return int(info.get('received_timestamp') or 0) or node.get_clock().now().nanoseconds
+
+
+class CommandClock:
+    """Time between successive commands of a simulated plant, never negative.
+
+    A command stamped before the previous one (a bag replayed again, a stale
+    message) applies with no time elapsed, with a warning, and the clock does
+    not go back.
+    """
+
+    def __init__(self) -> None:
+        self.last_ns: int | None = None
+
+    def advance(self, ns: int, logger: Any) -> tuple[int, float]:
+        """The sample's time (ns) and the seconds since the previous command."""
+        dt_s = 0.0 if self.last_ns is None else (ns - self.last_ns) * 1e-9
+        if dt_s < 0.0:
+            logger.warning(f'command stamped {-dt_s:.3g} s before the previous one: applied '
+                           'with no time elapsed', throttle_duration_sec=5.0)
+            dt_s, ns = 0.0, self.last_ns
+        self.last_ns = ns
+        return ns, dt_s
