@@ -24,7 +24,9 @@ compensator that follows it (the "desired value vs reference" column of
 ``hyst-id experiment``).
 
 For pressure and flow this prints that floor for calibrations of growing
-richness, all fitted on the identification run by variable projection:
+richness, all fitted on the identification run by variable projection (the
+package's :func:`~hyst_id.experiment.run.fit_position_calibration`, and a
+fit of its own here only for the lead, which the package does not model):
 
 * ``linear``: ``k F(position) + b`` (the paper's procedure; ``F`` the
   channel's sensor lag: first order for pressure, second order for flow);
@@ -45,8 +47,8 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from hyst_id.experiment.result import CLEAN_SERIES, ExperimentConfig
-from hyst_id.experiment.run import eps_c_percent, fit_position_calibration, \
-    ideal_actuator_params
+from hyst_id.experiment.run import calibration_lag, eps_c_percent, \
+    fit_position_calibration, ideal_actuator_params
 from hyst_id.models.sensors import simulate_first_order, simulate_second_order
 from hyst_id.rig import simulate_rig
 from hyst_id.rig.params_file import load_rig_params
@@ -63,25 +65,21 @@ def lag(channel: str, theta, x: np.ndarray, t: np.ndarray) -> np.ndarray:
     return simulate_second_order(x, t, theta[0], theta[1])
 
 
-def fit(channel: str, t: np.ndarray, pos: np.ndarray, y: np.ndarray, degree: int,
-        gain_law: bool, lead: bool):
-    """Fit ``y = g(t) (sum_i a_i F(p^i) + a_l F(hp(p)) + b0) + b1`` (no law: one offset).
+def fit_with_lead(channel: str, t: np.ndarray, pos: np.ndarray, y: np.ndarray, degree: int):
+    """Fit ``y = (1 + r t) (sum_i a_i F(z^i) + a_l F(hp(p)) + b0) + b1``, ``hp`` a high-pass.
 
-    Returns the lag (and rate, lead) parameters, the linear coefficients, the
+    Returns the lag, rate and lead time constant, the linear coefficients, the
     position's centre and scale, and the rms residual.
     """
     centre, scale = float(pos.mean()), float(pos.std())
     powers = [((pos - centre) / scale) ** i for i in range(1, degree + 1)]
     n_lag = 1 if channel == 'pressure' else 2
-    span = float(t[-1] - t[0])
+    rate = 1.0 / float(t[-1] - t[0])
 
     def columns(theta):
         fs = [lag(channel, theta[:n_lag], p, t) for p in powers]
-        if lead:
-            fs.append(lag(channel, theta[:n_lag],
-                          pos - simulate_first_order(pos, t, theta[n_lag + 1]), t))
-        if not gain_law:
-            return np.column_stack(fs + [np.ones_like(t)])
+        fs.append(lag(channel, theta[:n_lag],
+                      pos - simulate_first_order(pos, t, theta[n_lag + 1]), t))
         g = 1.0 + theta[n_lag] * (t - t[0])       # linear, as (b) uses for gain_drift
         return np.column_stack([g[:, None] * np.column_stack(fs), g, np.ones_like(t)])
 
@@ -89,18 +87,15 @@ def fit(channel: str, t: np.ndarray, pos: np.ndarray, y: np.ndarray, degree: int
         a = columns(theta)
         return y - a @ np.linalg.lstsq(a, y, rcond=None)[0]
 
-    rate = 1.0 / span if gain_law else 1e-12     # without a gain law the rate is unused
-    lo = list(BOUNDS[channel][0]) + [-0.99 * rate] + ([0.05] if lead else [])
-    hi = list(BOUNDS[channel][1]) + [rate] + ([200.0] if lead else [])
+    lo = list(BOUNDS[channel][0]) + [-0.99 * rate, 0.05]
+    hi = list(BOUNDS[channel][1]) + [rate, 200.0]
     best = None
     for start in LAGS[channel]:
-        for tz in ((2.0, 20.0) if lead else (None,)):
-            x0 = list(start) + [0.0] + ([tz] if lead else [])
-            sol = least_squares(residual, x0, bounds=(lo, hi))
+        for tz in (2.0, 20.0):
+            sol = least_squares(residual, list(start) + [0.0, tz], bounds=(lo, hi))
             if best is None or sol.cost < best.cost:
                 best = sol
-    a = columns(best.x)
-    coef = np.linalg.lstsq(a, y, rcond=None)[0]
+    coef = np.linalg.lstsq(columns(best.x), y, rcond=None)[0]
     return best.x, coef, (centre, scale), float(np.sqrt(np.mean(residual(best.x) ** 2)))
 
 
@@ -116,21 +111,25 @@ def main() -> None:
     print('|---|---|---|---|---|')
     for ch in ('pressure', 'flow'):
         y, pos = run.measurement(ch), run.position
-        paper_b = fit_position_calibration(ch, t_id, pos, y).b   # Eq. 26's offset
+        paper = fit_position_calibration(ch, t_id, pos, y)
         w_ref = reference.truth[CLEAN_SERIES[ch]]
         n_lag = 1 if ch == 'pressure' else 2
-        for name, degree, law, lead in (('linear', 1, False, False),
-                                        ('+ gain law', 1, True, False),
-                                        ('+ gain law + polynomial', 3, True, False),
-                                        ('+ gain law + lead', 1, True, True),
-                                        ('+ gain law + polynomial + lead', 3, True, True)):
-            theta, coef, (centre, scale), rms = fit(ch, t_id, pos, y, degree, law, lead)
+        for name, law, degree in (('linear', 'none', 1), ('+ gain law', 'linear', 1),
+                                  ('+ gain law + polynomial', 'linear', 3)):
+            cal = paper if law == 'none' else fit_position_calibration(ch, t_id, pos, y, law,
+                                                                       degree)
+            floor = eps_c_percent(calibration_lag(cal, cal.from_position(u_d), t_c), w_ref,
+                                  paper.b)
+            shown = ', '.join(f'{v:.3g}' for k, v in cal.dynamics.items()
+                              if k in ('tau_s', 'zeta', 'omega_n'))
+            print(f'| {ch} | {name} | {shown} | {cal.rms_residual:.4g} | {floor:.2f} |')
+        for name, degree in (('+ gain law + lead', 1), ('+ gain law + polynomial + lead', 3)):
+            theta, coef, (centre, scale), rms = fit_with_lead(ch, t_id, pos, y, degree)
             ud = (u_d - centre) / scale
             # the desired value at the run's start (g = 1), static: the lead is the
             # unregulated pipe's, the regulated reference has none to follow
-            n_dyn = degree + int(lead)       # coefficients of the lagged columns
-            desired = sum(coef[i] * ud ** (i + 1) for i in range(degree)) + sum(coef[n_dyn:])
-            floor = eps_c_percent(lag(ch, theta[:n_lag], desired, t_c), w_ref, paper_b)
+            desired = sum(coef[i] * ud ** (i + 1) for i in range(degree)) + coef[-2] + coef[-1]
+            floor = eps_c_percent(lag(ch, theta[:n_lag], desired, t_c), w_ref, paper.b)
             shown = ', '.join(f'{v:.3g}' for v in theta[:n_lag])
             print(f'| {ch} | {name} | {shown} | {rms:.4g} | {floor:.2f} |')
 

@@ -73,7 +73,7 @@ from hyst_id.models.tk import loop_corners
 from hyst_id.rig import as_rig_params, RigParams, simulate_rig
 from hyst_id.signals.excitation import eq24, eq25
 
-__all__ = ['run_experiment', 'calibration_by_bic', 'fit_position_calibration',
+__all__ = ['run_experiment', 'calibration_by_bic', 'calibration_lag', 'fit_position_calibration',
            'to_position_units', 'to_backlash_gauge', 'eps_c_percent', 'ideal_actuator_params']
 
 
@@ -350,13 +350,17 @@ def _adaptive(sc: ScenarioResult, rig: RigParams, config: ExperimentConfig,
             progress(1, total, f'{key} {ch}: diagnosis {diag.verdict}, augmented and tracking')
 
 
+def calibration_lag(cal: Calibration, x: np.ndarray, t_s: np.ndarray) -> np.ndarray:
+    """``x`` (channel units) through the calibration's fitted lag (none for position)."""
+    names = {'pressure': ('tau_s',), 'flow': ('zeta', 'omega_n')}.get(cal.channel)
+    if names is None:
+        return np.asarray(x, dtype=float)
+    return _lag(cal.channel, np.array([cal.dynamics[n] for n in names]), x, t_s)
+
+
 def _desired_floor(sc: ScenarioResult, ch: str, cal: Calibration) -> float:
     """%ε_c of a perfect compensator: the desired value through the calibration's lag."""
-    t = sc.reference.t_s
-    desired = cal.from_position(sc.uncompensated.command_ma)
-    names = {'pressure': ('tau_s',), 'flow': ('zeta', 'omega_n')}.get(ch)
-    w = desired if names is None else _lag(ch, np.array([cal.dynamics[n] for n in names]),
-                                           desired, t)
+    w = calibration_lag(cal, cal.from_position(sc.uncompensated.command_ma), sc.reference.t_s)
     return eps_c_percent(w, sc.reference.truth[CLEAN_SERIES[ch]], sc.calibrations[ch].b)
 
 
