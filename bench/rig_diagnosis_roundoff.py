@@ -18,8 +18,9 @@ The unregulated paper rig's Eq. 24 identification run (what ``hyst-id
 experiment`` column (b) diagnoses) is diagnosed once per round-off probe
 (``HYST_ID_ROUNDOFF_PROBE``: 0 = none, 1-3 perturb the recording's last
 bits as another CPU's sums would); each line prints the verdict, the
-findings and the final held-out %e_r. A verdict that changes between
-probes is a tie the data do not decide.
+findings, the final held-out %e_r, each finding's alternatives (tied or
+close calls) and the first round's drift blocks with their judged held-out
+%e_r. A verdict that changes between probes is a tie the data do not decide.
 
 Usage: ``python bench/rig_diagnosis_roundoff.py [--channel pressure] [--probes 0 1 2 3]``
 (about a minute per probe).
@@ -41,9 +42,12 @@ rig = as_rig_params('params/paper_rig.yaml').with_values({'supply.regulation': F
 t = np.arange(0.0, 100.0, 0.05)
 run = simulate_rig(rig, t, eq24(t), seed=0)
 d = diagnose(run.recording(%r), settings=DiagnoseSettings(max_mechanisms=3))
+first = {c['mechanism']: round(c['er_judged_percent'], 4)
+         for c in d.to_dict()['tested'][0]['candidates']
+         if c['mechanism'] in ('offset_drift', 'gain_drift', 'supply_decay')}
 print(d.verdict, [f.mechanism for f in d.findings], round(d.final.er_holdout_percent, 4),
       [[f"{a['mechanism']} ({a.get('kind', 'tied')})" for a in f.alternatives]
-       for f in d.findings])
+       for f in d.findings], 'round 1 drift blocks (judged held-out %%e_r):', first)
 """
 
 

@@ -78,10 +78,9 @@ class Criteria:
     tie_floor: float = 1.25
     #: accepted runners-up within this ratio of the winner's judged held-out %e_r are
     #: reported as a judgement call (:func:`close_calls`). On the paper rig's pressure
-    #: run the runner-up drift block came 1.12 x the winner's (gain_drift 0.285 % vs
-    #: offset_drift 0.254 %), while the winner itself moved 0.20-0.29 % with round-off
-    #: (``bench/rig_diagnosis_roundoff.py``): 1.25 names the former; it cannot make the
-    #: latter stable
+    #: run the other drift block came 1.12-3.3 x the winner's over four round-off probes
+    #: (``bench/rig_diagnosis_roundoff.py``): 1.25 names the closest case; it cannot
+    #: make a runner-up whose own fit moves with round-off stable
     judgement_ratio: float = 1.25
 
 

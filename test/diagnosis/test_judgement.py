@@ -14,10 +14,10 @@
 
 """Judgement calls (issue 14): a runner-up close to the winner is named with the finding.
 
-On the paper rig's pressure run the best drift block's held-out %e_r moved by
-up to 20 % with round-off alone, and which of ``offset_drift`` /
-``gain_drift`` won changed with it; the report must say that the choice is
-close rather than present one name as settled.
+On the paper rig's pressure run which of ``offset_drift`` / ``gain_drift``
+wins changes with round-off alone (``bench/rig_diagnosis_roundoff.py``), and
+in one probe the other came 1.12 x the winner's held-out error; the report
+must say that such a choice is close rather than present one name as settled.
 """
 
 from __future__ import annotations
