@@ -329,6 +329,8 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument('--n', type=int, default=200, help='recordings')
     ap.add_argument('--start', type=int, default=0, help='first recording index')
+    ap.add_argument('--indices', type=int, nargs='+', metavar='I',
+                    help='only these recordings (e.g. the misses of a previous run)')
     ap.add_argument('--seeds', type=int, default=10, help='identify seeds')
     ap.add_argument('--methods', default='identify,CMA-ES,DE')
     ap.add_argument('--workers', type=int, default=os.cpu_count() or 1)
@@ -347,7 +349,7 @@ def main(argv: list[str] | None = None) -> int:
         print(_summary([results[i] for i in sorted(results)], methods))
         return 0
     results = []
-    indices = range(args.start, args.start + args.n)
+    indices = args.indices or range(args.start, args.start + args.n)
     with ProcessPoolExecutor(args.workers) as pool:
         futures = [pool.submit(run_case, i, methods, args.seeds) for i in indices]
         for fut in futures:

@@ -66,9 +66,12 @@ def add_settings_arguments(parser: argparse.ArgumentParser) -> None:
                    help='extra GAASS runs per seed while %%e_r stays above 1.05 x the '
                    'noise floor (default 4; 0 = one run per seed)')
     g.add_argument('--global-evals', type=int, default=200000, metavar='N',
-                   help='evaluations of the global phase run when the best fit stays above '
-                   '1.1 x the noise floor (default 200000; 0 = no global phase: faster, '
-                   'but a trapped fit stays trapped)')
+                   help='evaluations of each global-phase run (one per initial state and '
+                   'sensor hold, then longer ones) while the best fit stays above 1.1 x the '
+                   'noise floor (default 200000; 0 = no global phase: faster, but a trapped '
+                   'fit stays trapped)')
+    g.add_argument('--global-runs', type=int, default=6, metavar='N',
+                   help='most runs of the global phase (default 6; 0 = none)')
     g.add_argument('--search-samples', type=int, default=20000, metavar='N',
                    help='on a longer record GAASS searches on every k-th sample plus every '
                    'command reversal; refinement and results use all samples '
@@ -101,7 +104,8 @@ def make_settings(args: argparse.Namespace) -> IdentifySettings:
         seeds=args.seeds, seed_offset=args.seed_offset, pop_size=args.pop_size,
         generations=args.generations, c=args.c, xi=args.xi, workers=args.workers,
         refine=not args.gaass_only, restarts=args.restarts, er_bound_percent=args.er_bound,
-        global_evals=args.global_evals, search_samples=args.search_samples)
+        global_evals=args.global_evals, global_runs=args.global_runs,
+        search_samples=args.search_samples)
 
 
 def make_spec(args: argparse.Namespace, rec: Recording, family: str | None = None) -> ChainSpec:

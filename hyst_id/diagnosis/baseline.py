@@ -73,8 +73,10 @@ def baseline_starts(rec_train: Recording, spec: ChainSpec, settings, *, thorough
     runs = []
     for conventions in (('given', 'auto') if thorough else ('given',)):
         global_evals = IdentifySettings.global_evals if thorough else 0   # identify's default
+        # one global run in the given conventions, two (best and runner-up) in 'auto'
         ident = identify(rec_train, spec=spec, settings=IdentifySettings(
-            **base, conventions=conventions, global_evals=global_evals))
+            **base, conventions=conventions, global_evals=global_evals,
+            global_runs=1 if conventions == 'given' else 2))
         own = [r for r in ident.runs if r.initial == spec.initial]
         if own:
             runs.append(min(own, key=lambda r: r.fun))

@@ -23,7 +23,9 @@ The stage's modules, in pipeline order:
 :mod:`.refine`            local least-squares polish after the global search
 :mod:`.gauge`             the chain's gauge freedom and its canonical form
 :mod:`.driver`            :func:`identify`: seeds, GAASS, refinement, restarts,
-                          conventions, the global phase
+                          conventions
+:mod:`.global_phase`      differential evolution over the whole box after the
+                          seeds: every convention, then longer runs
 :mod:`.model_choice`      H's family chosen on held-out data (``--model auto``)
 :mod:`.quality`           warnings on what the recording could not determine
 :mod:`.result`            :class:`IdentifySettings`, :class:`SeedRun`,

@@ -41,6 +41,7 @@ from hyst_id.identification.chains import (
 )
 from hyst_id.identification.domains import domains_from_data
 from hyst_id.identification.gauge import canonical_gauge, output_sign
+from hyst_id.identification.global_phase import global_phase, global_phases
 from hyst_id.identification.quality import assess
 from hyst_id.identification.refine import refine
 from hyst_id.identification.result import Identification, IdentifySettings, SeedRun
@@ -412,64 +413,11 @@ def identify(recording: Recording, *, spec: ChainSpec | None = None,
                        for seed in settings.seeds], n_workers,
             on_result=on_result, should_stop=should_stop)
     best = min(runs, key=lambda r: r.fun)
-    # the global phase under the best run's conventions, then under the runner-up's
-    # (the ranking of conventions is made from data-built starts and can be wrong)
-    phases = [replace(spec, initial=best.initial, hold=best.hold)]
-    phases += [s for s in others if (s.initial, s.hold) != (best.initial, best.hold)][:1]
-    for k, phase_spec in enumerate(phases):
-        if not (settings.refine and settings.global_evals > 0
-                and best.er_percent > settings.global_factor * floor):
-            break
-        extra = global_phase(phase_spec, rec, settings, seed=settings.seeds[0], run_id=-1 - k)
-        if extra.fun < best.fun:
-            runs.append(extra)
-            best = extra
+    runs += global_phases(spec, others, rec, settings, best, floor, n_workers, should_stop)
     ident = summarise(rec, spec, settings, runs)
     warnings, ident.poorly_determined = assess(ident, rec, spec)
     ident.warnings += warnings
     return ident
-
-
-def global_phase(spec: ChainSpec, rec: Recording, settings: IdentifySettings,
-                 seed: int, run_id: int = -1) -> SeedRun:
-    """One long differential-evolution run over the whole box, refined: seed ``run_id``.
-
-    GAASS contracts its search space around its best chromosomes, so when
-    every seed starts in the same wrong basin they all stay there. On the
-    reference family (``bench/generalisation.py``, 200 recordings) scipy's
-    differential evolution at the evaluations of ``identify`` reached the
-    true floor on about half of the recordings ``identify`` missed (its
-    large population keeps the whole box in play), while missing others;
-    run after the seeds, only when they end above the floor, it is the
-    global phase that leaves their basin. ``settings.global_evals`` bounds
-    its evaluations (popsize 15 per parameter, ``tol = 0``), the refinement
-    adds ``refine_max_nfev``.
-    """
-    from scipy.optimize import differential_evolution
-    t_s, v, y = rec.t_s, rec.command, rec.measurement
-    cost = spec.cost_function(t_s, v, y)
-    popsize = 15
-    maxiter = max(1, settings.global_evals // (popsize * spec.n_params) - 1)
-    with threadpool_limits(limits=1):
-        res = differential_evolution(lambda x: cost(np.ascontiguousarray(x.T)), spec.bounds,
-                                     maxiter=maxiter, popsize=popsize, tol=0.0, atol=0.0,
-                                     polish=False, rng=np.random.default_rng(  # -1: as before
-                                         [seed, 7] if run_id == -1 else [seed, 7, -run_id]),
-                                     vectorized=True, updating='deferred')
-        x_raw, fun = np.asarray(res.x, dtype=float), float(res.fun)
-        x_ref, fun_ref, nfev_ref = refine(spec, x_raw, t_s, v, y,
-                                          max_nfev=settings.refine_max_nfev)
-    if fun_ref < fun:
-        x_raw, fun = x_ref, fun_ref
-    k, b = spec.fit_calibration(x_raw, t_s, v, y)
-    x = canonical_gauge(x_raw, (k, b), spec.family) if k != 0 else x_raw
-    return SeedRun(seed=run_id, x_raw=x_raw, x=x, sign=output_sign((k, b)) if k != 0 else 1.0,
-                   fun=fun if k != 0 else np.inf, er_percent=float(er_percent(fun, y)),
-                   er_gaass_percent=float('nan'),
-                   nfev=(int(res.nit) + 1) * popsize * spec.n_params + int(nfev_ref),
-                   nit=int(res.nit), best_history=np.zeros(0),
-                   message='differential evolution (global phase)', initial=spec.initial,
-                   hold=spec.hold)
 
 
 def summarise(rec: Recording, spec: ChainSpec, settings: IdentifySettings,

@@ -74,13 +74,17 @@ class IdentifySettings:
         odd restarts try the runner-up); ``given``: keep the spec's.
     global_evals : int
         With refinement on, when the seeds end above ``global_factor`` times
-        the estimated noise floor, one run of scipy's differential evolution
-        with this many evaluations (a large population over the whole box,
-        under the best run's conventions), refined, joins the runs as seed
-        ``-1`` when it does better (:func:`hyst_id.identification.driver.global_phase`).
-        0: off.
+        the estimated noise floor, runs of scipy's differential evolution
+        over the whole box, each refined, join the runs (seeds ``-1``,
+        ``-2``, ...) when they do better: one per initial state and sensor
+        hold convention with this many evaluations, then runs with three
+        times as many under the best fit's conventions, in rounds of two
+        until the fit reaches ``global_factor`` or ``global_runs`` are spent
+        (:mod:`hyst_id.identification.global_phase`). 0: off.
     global_factor : float
         The floor multiple above which the global phase runs.
+    global_runs : int
+        Most runs of the global phase (0: off).
     search_samples : int
         With refinement on, on a record longer than this the GAASS runs, the
         polishes of each run's best chromosomes and of the data-built starts
@@ -109,6 +113,7 @@ class IdentifySettings:
     conventions: str = 'auto'
     global_evals: int = 200000
     global_factor: float = 1.1
+    global_runs: int = 6
     search_samples: int = 20000
 
 

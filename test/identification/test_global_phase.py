@@ -1,0 +1,147 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""The global phase's schedule: every convention first, then longer runs; never by core count."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+import importlib
+from pathlib import Path
+import sys
+
+import numpy as np
+import pytest
+
+from hyst_id.identification import identify, IdentifySettings
+from hyst_id.identification.chains import chain_spec
+from hyst_id.identification.result import SeedRun
+from hyst_id.io.recording import Recording
+
+gp = importlib.import_module('hyst_id.identification.global_phase')
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / 'bench'))
+import generalisation as FAMILY  # noqa: E402, I100
+
+
+def _run(spec, fun, run_id=0):
+    return SeedRun(seed=run_id, x_raw=np.zeros(spec.n_params), x=np.zeros(spec.n_params),
+                   sign=1.0, fun=fun, er_percent=fun, er_gaass_percent=float('nan'), nfev=1,
+                   nit=1, best_history=np.zeros(0), message='', initial=spec.initial,
+                   hold=spec.hold)
+
+
+def _others(spec):
+    return [replace(spec, initial=i, hold=h) for i, h in
+            (('falling', 'before'), ('rising', 'after'), ('falling', 'after'),
+             ('rising', 'before'))]
+
+
+@pytest.fixture
+def calls(monkeypatch):
+    """Record each global-phase run; each scores ``scores[j]`` (%e_r) in turn."""
+    made = []
+
+    def fake(spec, rec, settings, seed, run_id=-1, evals=None):
+        made.append((spec.initial, spec.hold, run_id, evals or settings.global_evals))
+        return _run(spec, made_scores[len(made) - 1], run_id)
+    made_scores = []
+    monkeypatch.setattr(gp, 'global_phase', fake)
+    return made, made_scores
+
+
+def test_every_convention_before_longer_runs_under_the_best(calls):
+    made, scores = calls
+    spec = chain_spec('pressure')
+    scores += [9.0, 8.0, 1.5, 7.0, 1.4, 1.3]          # never below 1.1 x a floor of 1
+    best = _run(replace(spec, initial='rising', hold='before'), 10.0)
+    settings = IdentifySettings(global_evals=1000)
+    improved = gp.global_phases(spec, _others(spec), None, settings, best, 1.0)
+    # the best run's conventions, then each other once, then 3 x longer under the best so far
+    assert [m[:2] for m in made] == [('rising', 'before'), ('falling', 'before'),
+                                     ('rising', 'after'), ('falling', 'after'),
+                                     ('rising', 'after'), ('rising', 'after')]
+    assert [m[2] for m in made] == [-1, -2, -3, -4, -5, -6]
+    assert [m[3] for m in made] == [1000] * 4 + [3000] * 2
+    assert [r.fun for r in improved] == [9.0, 8.0, 1.5, 1.4, 1.3]
+
+
+def test_no_longer_runs_far_from_the_floor(calls):
+    """Beyond 1.5 x the floor the misfit is taken for missing physics, not a trap."""
+    made, scores = calls
+    spec = chain_spec('flow')
+    scores += [9.0, 8.0, 1.6, 7.0]
+    gp.global_phases(spec, _others(spec), None, IdentifySettings(), _run(spec, 10.0), 1.0)
+    assert len(made) == 4                               # the conventions only
+
+
+def test_stops_after_the_round_that_reaches_the_floor(calls):
+    made, scores = calls
+    spec = chain_spec('flow')
+    scores += [5.0, 1.05, 0.5, 0.4]
+    best = _run(spec, 10.0)
+    improved = gp.global_phases(spec, _others(spec), None, IdentifySettings(), best, 1.0)
+    assert len(made) == 2                               # a round is two runs
+    assert [r.fun for r in improved] == [5.0, 1.05]
+
+
+@pytest.mark.parametrize('settings', [IdentifySettings(global_runs=0),
+                                      IdentifySettings(global_evals=0),
+                                      IdentifySettings(refine=False)])
+def test_off(calls, settings):
+    made, scores = calls
+    spec = chain_spec('flow')
+    assert gp.global_phases(spec, [], None, settings, _run(spec, 10.0), 1.0) == []
+    assert made == []
+
+
+def test_at_the_floor_nothing_runs(calls):
+    made, _ = calls
+    spec = chain_spec('flow')
+    assert gp.global_phases(spec, _others(spec), None, IdentifySettings(),
+                            _run(spec, 1.09), 1.0) == []
+    assert made == []
+
+
+def test_the_same_runs_with_one_or_two_workers():
+    """The schedule and streams do not depend on the core count (real DE, small budget)."""
+    case = FAMILY.draw_case(2, n_samples=300)
+    rec = Recording(case.t_s, case.command, case.measurement, case.channel, 'u', 'y', 'family')
+    from hyst_id.identification.domains import domains_from_data
+    spec = domains_from_data(rec)
+    settings = IdentifySettings(global_evals=3000, global_runs=3)
+    best = _run(spec, np.inf)
+    best.er_percent = np.inf
+    one = gp.global_phases(spec, _others(spec), rec, settings, best, 1e-9, n_workers=1)
+    two = gp.global_phases(spec, _others(spec), rec, settings, best, 1e-9, n_workers=2)
+    assert one
+    assert [(r.seed, r.initial, r.hold) for r in one] == [(r.seed, r.initial, r.hold)
+                                                          for r in two]
+    for a, b in zip(one, two):
+        np.testing.assert_array_equal(a.x_raw, b.x_raw)
+
+
+@pytest.mark.slow
+def test_the_sweep_finds_the_convention_the_ranking_missed():
+    """Reference family #44: every seed and both first global runs stay at 3.6-5.9 x.
+
+    Ten seeds ended on one data-built start at 3.65 x the true floor and the
+    global runs under the two best-ranked conventions at 5.15 and 5.90 x;
+    the run under the third convention reaches 1.000 x
+    (``bench/generalisation.py``, docs/benchmarks.md).
+    """
+    case = FAMILY.draw_case(44)
+    rec = Recording(case.t_s, case.command, case.measurement, case.channel, 'u', 'y', '#44')
+    ident = identify(rec, settings=IdentifySettings(workers=1))
+    assert ident.er_percent / FAMILY.true_floor(case) <= 1.1
