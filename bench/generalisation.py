@@ -43,6 +43,9 @@ with all methods)::
     python bench/generalisation.py --n 20 --methods identify --seeds 4
     python bench/generalisation.py --jsonl runs.jsonl      # saves each recording
     python bench/generalisation.py --summarise runs.jsonl  # the table from saved runs
+    python bench/generalisation.py --against runs.jsonl --jsonl others.jsonl
+        # CMA-ES and DE at identify's evaluations of a saved run, and CMA-ES's
+        # wall time to reach identify's error (up to --reach-budget x them)
 """
 
 from __future__ import annotations
@@ -213,8 +216,14 @@ def true_floor(case: Case) -> float:
     return floor_percent(case.measurement, case.noise_std)
 
 
-def cmaes_minimise(spec, rec, seed: int, budget: int) -> tuple[float, np.ndarray]:
-    """Plain CMA-ES (``cmaes``, IPOP restarts) on ``spec``'s cost: best J and its parameters."""
+def cmaes_minimise(spec, rec, seed: int, budget: int, target: float | None = None,
+                   reached: list | None = None) -> tuple[float, np.ndarray]:
+    """Plain CMA-ES (``cmaes``, IPOP restarts) on ``spec``'s cost: best J and its parameters.
+
+    With ``target``, the run stops once J <= target and appends its wall
+    time and evaluations to ``reached``.
+    """
+    t0 = time.perf_counter()
     from cmaes import CMA
     cost = spec.cost_function(rec.t_s, rec.command, rec.measurement)
     lo, width = spec.bounds[:, 0], spec.bounds[:, 1] - spec.bounds[:, 0]
@@ -236,6 +245,9 @@ def cmaes_minimise(spec, rec, seed: int, budget: int) -> tuple[float, np.ndarray
             nfev += len(zs)
             if float(values.min()) < best:
                 best, best_x = float(values.min()), xs[int(np.argmin(values))]
+            if target is not None and best <= target:
+                reached += [time.perf_counter() - t0, nfev]
+                return best, best_x
             opt.tell(list(zip(zs, values)))
         pop_size = opt.population_size * 2          # IPOP
     return best, best_x
@@ -288,6 +300,42 @@ def run_case(index: int, methods: tuple[str, ...], seeds: int) -> dict:
     return out
 
 
+def run_against(row: dict, reach_budget: float) -> dict:
+    """CMA-ES and DE on recording ``row['index']`` at the evaluations identify used there.
+
+    ``row`` is identify's line of an earlier run (``--jsonl``). Both get the
+    true initial state and sensor hold (a help identify does not have). CMA-ES
+    also runs on, up to ``reach_budget`` x identify's evaluations, until it
+    reaches identify's error: ``'CMA-ES reach'`` is ``[seconds, evaluations,
+    True]`` when it got there, else ``[seconds of the whole run, its
+    evaluations, False]`` (a lower bound).
+    """
+    from threadpoolctl import threadpool_limits
+
+    from hyst_id.identification.domains import domains_from_data
+    case = draw_case(row['index'])
+    rec = recording(case)
+    floor = true_floor(case)
+    out = dict(row)
+    budget = int(row['identify'][1])
+    spec = replace(domains_from_data(rec), initial=case.note.split(', ')[-1], hold='after')
+    scale = float(rec.measurement @ rec.measurement)
+    with threadpool_limits(limits=1):
+        for name, fn in (('CMA-ES', _cmaes), ('DE', _de)):
+            t0 = time.perf_counter()
+            fun = fn(spec, rec, row['index'], budget)
+            er = float(np.sqrt(fun / scale) * 100.0)
+            out[name] = (er / floor, budget, time.perf_counter() - t0)
+        target = (row['identify'][0] * floor / 100.0) ** 2 * scale
+        reached: list = []
+        t0 = time.perf_counter()
+        cmaes_minimise(spec, rec, row['index'], int(reach_budget * budget), target, reached)
+        # [seconds, evaluations, reached]; not reached: the whole run's time, a lower bound
+        out['CMA-ES reach'] = reached + [True] if reached else \
+            [time.perf_counter() - t0, int(reach_budget * budget), False]
+    return out
+
+
 def _summary(results: list[dict], methods: tuple[str, ...]) -> str:
     lines = [f'{len(results)} recordings of the reference family', '',
              '| method | within 1.05 x | within 1.1 x | median | worst | median evals | '
@@ -314,6 +362,17 @@ def _summary(results: list[dict], methods: tuple[str, ...]) -> str:
     for m in others:
         both = sum(min(r['identify'][0], r[m][0]) <= 1.1 for r in ours if m in r)
         lines.append(f'the better of identify and {m} within 1.1 x: {both}/{len(ours)}')
+    reach = [r for r in ours if 'CMA-ES reach' in r]
+    if reach:
+        hit = [r['CMA-ES reach'] for r in reach if r['CMA-ES reach'][2]]
+        lower = np.median([r['CMA-ES reach'][0] for r in reach])
+        ident_wall = np.median([r['identify'][2] for r in reach])
+        where = np.median([h[0] for h in hit]) if hit else np.nan
+        lines.append(f"CMA-ES reached identify's error within {reach[0].get('reach_budget', 3)}"
+                     f' x its evaluations on {len(hit)}/{len(reach)} (median {where:.1f} s '
+                     f'where it did); median wall time to get there at least {lower:.1f} s '
+                     f"(the run's time where it did not), against identify's median "
+                     f'{ident_wall:.1f} s: identify takes at most {ident_wall / lower:.2f} of it')
     misses = sorted((r for r in ours if r['identify'][0] > 1.1),
                     key=lambda r: -r['identify'][0])
     if misses:
@@ -335,6 +394,10 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument('--methods', default='identify,CMA-ES,DE')
     ap.add_argument('--workers', type=int, default=os.cpu_count() or 1)
     ap.add_argument('--jsonl', help='append one JSON line per recording to this file')
+    ap.add_argument('--against', metavar='JSONL',
+                    help="run CMA-ES and DE at the evaluations of identify's lines in this "
+                    "file (and CMA-ES on to identify's error, up to --reach-budget x them)")
+    ap.add_argument('--reach-budget', type=float, default=3.0)
     ap.add_argument('--summarise', nargs='+', metavar='JSONL',
                     help='print the table from saved --jsonl files and run nothing')
     args = ap.parse_args(argv)
@@ -350,8 +413,16 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     results = []
     indices = args.indices or range(args.start, args.start + args.n)
+    rows = {}
+    if args.against:
+        with open(args.against) as fh:
+            rows = {r['index']: {**r, 'reach_budget': args.reach_budget}
+                    for r in map(json.loads, fh)}
+        indices = [i for i in indices if i in rows] if args.indices else sorted(rows)
+        methods = ('identify', 'CMA-ES', 'DE')
     with ProcessPoolExecutor(args.workers) as pool:
-        futures = [pool.submit(run_case, i, methods, args.seeds) for i in indices]
+        futures = [pool.submit(run_against, rows[i], args.reach_budget) if rows else
+                   pool.submit(run_case, i, methods, args.seeds) for i in indices]
         for fut in futures:
             r = fut.result()
             results.append(r)
