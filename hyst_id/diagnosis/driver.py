@@ -182,7 +182,7 @@ def diagnose(recording: Recording, *, spec: ChainSpec | None = None,
 def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSettings,
               say: Callable[[str], None]) -> Diagnosis:
     rec = roundoff_probe(validate_recording(recording))
-    mechs = get_mechanisms(settings.mechanisms)
+    mechs = get_mechanisms(settings.mechanisms, channel=rec.channel)
     t, v_orig, y = rec.t_s, rec.command, rec.measurement
     n_train = split_index(t, settings.train_fraction)
     if n_train < 20 or t.size - n_train < 10:

@@ -34,7 +34,7 @@ from hyst_id.compensation.augment import Augmentation
 from hyst_id.compensation.params_file import read_compensator_params
 from hyst_id.diagnosis import diagnose, DiagnoseSettings
 from hyst_id.diagnosis.locate import locate, noise_std
-from hyst_id.diagnosis.mechanisms import Context, MECHANISM_IDS, MECHANISMS
+from hyst_id.diagnosis.mechanisms import Context, get_mechanisms, MECHANISM_IDS, MECHANISMS
 from hyst_id.diagnosis.mechanisms.base import COMPENSATION_KINDS
 from hyst_id.diagnosis.model import ComposedModel
 from hyst_id.diagnosis.report import plot_diagnosis
@@ -284,6 +284,25 @@ def test_bad_inputs_are_one_line_errors():
         diagnose(rec, settings=DiagnoseSettings(mechanisms=('friction',)))
     with pytest.raises(ConfigError, match='train fraction'):
         diagnose(rec, settings=DiagnoseSettings(train_fraction=1.5))
+    with pytest.raises(ConfigError, match='supply_decay cannot act on the position channel'):
+        diagnose(rec, settings=DiagnoseSettings(mechanisms=('dead_time', 'supply_decay')))
+
+
+def test_a_supply_is_not_physics_of_the_position_reading():
+    """The blind family's position recordings named a supply decay for gain and offset drifts."""
+    by_channel = {ch: [m.id for m in get_mechanisms(channel=ch)]
+                  for ch in ('position', 'pressure', 'flow')}
+    assert 'supply_decay' not in by_channel['position']
+    assert 'supply_decay' in by_channel['pressure'] and 'supply_decay' in by_channel['flow']
+    assert set(by_channel['position']) == set(MECHANISM_IDS) - {'supply_decay'}
+    # where no supply reaches, a gain may fall as well as grow; elsewhere falling is supply's
+    t = np.arange(100.0)
+    for ch, signed in (('position', True), ('pressure', False), ('flow', False)):
+        ctx = Context(ch, t, 70)
+        gd = MECHANISMS['gain_drift']
+        assert (gd.bounds(ctx)[0, 0] < 0) == signed
+        assert gd.bounds(ctx)[0, 0] <= gd.null(ctx)[0] <= gd.bounds(ctx)[0, 1]
+        assert any(s[0] < 0 for s in gd.starts(ctx)) == signed
 
 
 def test_cli_errors_are_one_line(tmp_path, capsys):
@@ -296,6 +315,9 @@ def test_cli_errors_are_one_line(tmp_path, capsys):
                header='t,command,measurement', comments='')
     assert main(['diagnose', str(csv), '--mechanisms', 'friction']) == 2
     assert 'unknown mechanism' in capsys.readouterr().err
+    assert main(['diagnose', str(csv), '--mechanisms', 'supply_decay', '--quiet']) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert 'supply_decay cannot act on the position channel' in err[-1], err
 
 
 def test_cli_writes_json_and_figure(tmp_path, capsys):

@@ -56,9 +56,14 @@ def test_a_growing_gain_is_gain_drift(seed):
     assert d.final.er_holdout_percent < 1.5 * d.noise_floor_percent
 
 
-def test_a_falling_gain_stays_supply_decay():
+def test_a_falling_gain_on_the_position_reading_is_gain_drift():
+    """No supply reaches a position reading: its falling gain is the sensor's, not supply's."""
     d = diagnose(_recording(3, lambda t: np.exp(-t / 300.0)), settings=SETTINGS)
-    assert d.verdict == 'supply_decay', [f.mechanism for f in d.findings]
+    assert d.verdict == 'gain_drift', [f.mechanism for f in d.findings]
+    growth = d.findings[0].params['growth_percent_per_s'].value
+    # exp(-t/300) over 120 s: a secant slope between -0.27 and -0.33 %/s
+    assert -0.40 < growth < -0.20, growth
+    assert 'falls' in d.findings[0].explanation
 
 
 def test_gain_drift_is_registered_with_words():

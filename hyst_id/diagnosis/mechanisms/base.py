@@ -154,6 +154,9 @@ class Mechanism:
     families : tuple of str or None
         Hysteresis families the block works with (None: any); a block that
         rewrites H itself needs the family it was written for.
+    channels : tuple of str or None
+        Channels whose physics the block can be (None: any): a supply running
+        down changes pressure and flow, never the valve's position reading.
     """
 
     id = ''  # noqa: A003 - the issue's word for a mechanism's name
@@ -166,6 +169,7 @@ class Mechanism:
     n_linear = 0
     smooth = True
     families: tuple[str, ...] | None = None
+    channels: tuple[str, ...] | None = None
 
     # -- fitting -----------------------------------------------------------
     def bounds(self, ctx: Context) -> np.ndarray:

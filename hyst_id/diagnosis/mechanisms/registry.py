@@ -50,11 +50,25 @@ MECHANISMS: dict[str, Mechanism] = {m.MECHANISM.id: m.MECHANISM for m in (
 MECHANISM_IDS = tuple(MECHANISMS)
 
 
-def get_mechanisms(ids=None) -> list[Mechanism]:
-    """Mechanisms by id (all when ``ids`` is None); unknown ids raise ConfigError."""
+def get_mechanisms(ids=None, channel: str | None = None) -> list[Mechanism]:
+    """Mechanisms by id (all when ``ids`` is None), those that can act on ``channel`` if given.
+
+    Raises
+    ------
+    ConfigError
+        An id is unknown, or a mechanism asked for by id cannot be ``channel``'s
+        physics (:attr:`Mechanism.channels`).
+    """
     if ids is None:
-        return list(MECHANISMS.values())
-    unknown = [i for i in ids if i not in MECHANISMS]
-    if unknown:
-        raise ConfigError(f'unknown mechanism(s) {unknown}; known: {list(MECHANISM_IDS)}')
-    return [MECHANISMS[i] for i in ids]
+        mechs = list(MECHANISMS.values())
+    else:
+        unknown = [i for i in ids if i not in MECHANISMS]
+        if unknown:
+            raise ConfigError(f'unknown mechanism(s) {unknown}; known: {list(MECHANISM_IDS)}')
+        mechs = [MECHANISMS[i] for i in ids]
+    off = [m for m in mechs if channel is not None and m.channels is not None
+           and channel not in m.channels]
+    if ids is not None and off:
+        raise ConfigError('; '.join(f'{m.id} cannot act on the {channel} channel (only on '
+                                    f'{", ".join(m.channels)})' for m in off))
+    return [m for m in mechs if m not in off]

@@ -46,6 +46,7 @@ class SupplyDecay(TimeGain):
     physics = ('the supply pressure falls during the run (vessels emptying without '
                'regulation), so pressure and flow for a given opening fall with it')
     gain_law = 'exponential'
+    channels = ('pressure', 'flow')   # the position sensor does not see the supply
     names = ('decay_rate_per_s',)
     units = ('1/s',)
     rate_range = (0.01, 5.0)          # a hundredth to five e-foldings
