@@ -413,7 +413,8 @@ def identify(recording: Recording, *, spec: ChainSpec | None = None,
                        for seed in settings.seeds], n_workers,
             on_result=on_result, should_stop=should_stop)
     best = min(runs, key=lambda r: r.fun)
-    runs += global_phases(spec, others, rec, settings, best, floor, n_workers, should_stop)
+    runs += global_phases(spec, others, rec, settings, best, floor, n_workers, should_stop,
+                          subset=search_subset(rec.command, settings.search_samples))
     ident = summarise(rec, spec, settings, runs)
     warnings, ident.poorly_determined = assess(ident, rec, spec)
     ident.warnings += warnings

@@ -62,16 +62,21 @@ LONG_RUNS_WITHIN = 1.5
 
 
 def global_phase(spec: ChainSpec, rec: Recording, settings: IdentifySettings,
-                 seed: int, run_id: int = -1, evals: int | None = None) -> SeedRun:
+                 seed: int, run_id: int = -1, evals: int | None = None,
+                 subset: np.ndarray | None = None) -> SeedRun:
     """One differential-evolution run over the whole box, refined: seed ``run_id``.
 
     ``evals`` (default ``settings.global_evals``) bounds its evaluations
     (popsize 15 per parameter, ``tol = 0``); the refinement adds
     ``refine_max_nfev``. Its random stream is drawn from ``(seed, run_id)``.
+    On a long record the search sees the sample indices ``subset``
+    (:func:`~hyst_id.identification.driver.search_subset`); the refinement
+    and the returned cost use every sample.
     """
     from scipy.optimize import differential_evolution
     t_s, v, y = rec.t_s, rec.command, rec.measurement
-    cost = spec.cost_function(t_s, v, y)
+    cost = spec.cost_function(*((t_s, v, y) if subset is None else
+                                (t_s[subset], v[subset], y[subset])))
     popsize = 15
     evals = settings.global_evals if evals is None else int(evals)
     maxiter = max(1, evals // (popsize * spec.n_params) - 1)
@@ -82,6 +87,8 @@ def global_phase(spec: ChainSpec, rec: Recording, settings: IdentifySettings,
                                          [seed, 7] if run_id == -1 else [seed, 7, -run_id]),
                                      vectorized=True, updating='deferred')
         x_raw, fun = np.asarray(res.x, dtype=float), float(res.fun)
+        if subset is not None:
+            fun = float(spec.cost_function(t_s, v, y)(x_raw[None, :])[0])
         x_ref, fun_ref, nfev_ref = refine(spec, x_raw, t_s, v, y,
                                           max_nfev=settings.refine_max_nfev)
     if fun_ref < fun:
@@ -99,8 +106,8 @@ def global_phase(spec: ChainSpec, rec: Recording, settings: IdentifySettings,
 
 def global_phases(spec: ChainSpec, others: list[ChainSpec], rec: Recording,
                   settings: IdentifySettings, best: SeedRun, floor_percent: float,
-                  n_workers: int = 1,
-                  should_stop: Callable[[], bool] | None = None) -> list[SeedRun]:
+                  n_workers: int = 1, should_stop: Callable[[], bool] | None = None,
+                  subset: np.ndarray | None = None) -> list[SeedRun]:
     """The global phase's runs that improved on ``best``, in the order they did.
 
     Parameters
@@ -121,6 +128,8 @@ def global_phases(spec: ChainSpec, others: list[ChainSpec], rec: Recording,
         Processes for a round's runs (results do not depend on it).
     should_stop : callable, optional
         As for :func:`~hyst_id.identification.workers.map_in_processes`.
+    subset : numpy.ndarray, optional
+        Sample indices the searches see on a long record (:func:`global_phase`).
     """
     if not (settings.refine and settings.global_evals > 0 and settings.global_runs > 0):
         return []
@@ -135,12 +144,13 @@ def global_phases(spec: ChainSpec, others: list[ChainSpec], rec: Recording,
         tasks = []
         for j in range(k, min(k + ROUND, settings.global_runs)):
             if j < len(sweep):
-                tasks.append((sweep[j], rec, settings, settings.seeds[0], -1 - j))
+                tasks.append((sweep[j], rec, settings, settings.seeds[0], -1 - j, None,
+                              subset))
             elif best.er_percent <= LONG_RUNS_WITHIN * floor_percent:
                 # other streams, longer, under the best fit's conventions
                 phase = replace(spec, initial=best.initial, hold=best.hold)
                 tasks.append((phase, rec, settings, settings.seeds[0], -1 - j,
-                              _LONG_RUN * settings.global_evals))
+                              _LONG_RUN * settings.global_evals, subset))
         if not tasks:
             break
         k += len(tasks)

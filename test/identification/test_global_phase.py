@@ -53,7 +53,7 @@ def calls(monkeypatch):
     """Record each global-phase run; each scores ``scores[j]`` (%e_r) in turn."""
     made = []
 
-    def fake(spec, rec, settings, seed, run_id=-1, evals=None):
+    def fake(spec, rec, settings, seed, run_id=-1, evals=None, subset=None):
         made.append((spec.initial, spec.hold, run_id, evals or settings.global_evals))
         return _run(spec, made_scores[len(made) - 1], run_id)
     made_scores = []
@@ -145,3 +145,17 @@ def test_the_sweep_finds_the_convention_the_ranking_missed():
     rec = Recording(case.t_s, case.command, case.measurement, case.channel, 'u', 'y', '#44')
     ident = identify(rec, settings=IdentifySettings(workers=1))
     assert ident.er_percent / FAMILY.true_floor(case) <= 1.1
+
+
+def test_a_long_record_is_searched_on_its_subset_and_scored_on_every_sample():
+    case = FAMILY.draw_case(3, n_samples=30000)
+    rec = Recording(case.t_s, case.command, case.measurement, case.channel, 'u', 'y', 'long')
+    from hyst_id.identification.domains import domains_from_data
+    from hyst_id.identification.driver import search_subset
+    spec = domains_from_data(rec)
+    sub = search_subset(rec.command, 5000)
+    assert sub is not None and sub.size < rec.n_samples // 3
+    settings = IdentifySettings(global_evals=2000, refine_max_nfev=50)
+    run = gp.global_phase(spec, rec, settings, 0, -1, subset=sub)
+    full = spec.cost_function(rec.t_s, rec.command, rec.measurement)(run.x_raw[None, :])[0]
+    assert run.fun == pytest.approx(full, rel=1e-9)
