@@ -269,7 +269,8 @@ def _de(spec, rec, seed: int, budget: int) -> float:
     return float(res.fun)
 
 
-def run_case(index: int, methods: tuple[str, ...], seeds: int) -> dict:
+def run_case(index: int, methods: tuple[str, ...], seeds: int,
+             global_runs: int | None = None) -> dict:
     """Every method on recording ``index``; ratios to the true floor, evaluations, time."""
     from threadpoolctl import threadpool_limits
 
@@ -283,7 +284,9 @@ def run_case(index: int, methods: tuple[str, ...], seeds: int) -> dict:
            'noise_error': estimate_noise_std(case.measurement) / case.noise_std - 1.0}
     with threadpool_limits(limits=1):
         t0 = time.perf_counter()
-        ident = identify(rec, settings=IdentifySettings(seeds=tuple(range(seeds)), workers=1))
+        more = {} if global_runs is None else {'global_runs': global_runs}
+        ident = identify(rec, settings=IdentifySettings(seeds=tuple(range(seeds)), workers=1,
+                                                        **more))
         nfev = sum(run.nfev for run in ident.runs)
         out['identify'] = (ident.er_percent / floor, nfev,
                            time.perf_counter() - t0)
@@ -392,6 +395,8 @@ def main(argv: list[str] | None = None) -> int:
                     help='only these recordings (e.g. the misses of a previous run)')
     ap.add_argument('--seeds', type=int, default=10, help='identify seeds')
     ap.add_argument('--methods', default='identify,CMA-ES,DE')
+    ap.add_argument('--global-runs', type=int, default=None,
+                    help="identify's global_runs (default: identify's default)")
     ap.add_argument('--workers', type=int, default=os.cpu_count() or 1)
     ap.add_argument('--jsonl', help='append one JSON line per recording to this file')
     ap.add_argument('--against', metavar='JSONL',
@@ -422,7 +427,8 @@ def main(argv: list[str] | None = None) -> int:
         methods = ('identify', 'CMA-ES', 'DE')
     with ProcessPoolExecutor(args.workers) as pool:
         futures = [pool.submit(run_against, rows[i], args.reach_budget) if rows else
-                   pool.submit(run_case, i, methods, args.seeds) for i in indices]
+                   pool.submit(run_case, i, methods, args.seeds, args.global_runs)
+                   for i in indices]
         for fut in futures:
             r = fut.result()
             results.append(r)
