@@ -65,8 +65,10 @@ def run(args: argparse.Namespace) -> int:
         spec = make_spec(args, rec, family=args.model)
         print(f'H family {spec.family.id}; search domains ({spec.domain_source}): '
               + format_domains(spec), file=sys.stderr)
-        ident = identify(rec, spec=spec, settings=settings,
-                         progress=_progress_bar(args, settings))
+        bar = _progress_bar(args, settings)
+        ident = identify(rec, spec=spec, settings=settings, progress=bar)
+        if bar is not None:
+            bar.close()
     print(format_table(ident))
     if choice is not None:
         print()
@@ -97,8 +99,12 @@ def _choose(args: argparse.Namespace, rec, settings):
         part = 'the first 70 %' if what == 'train' else 'the whole recording'
         print(f'{family}: identify on {part}', file=sys.stderr)
 
-    return choose_family(rec, AUTO_FAMILIES, settings=settings,
-                         progress=None if args.quiet else stage, seed_progress=bar)
+    try:
+        return choose_family(rec, AUTO_FAMILIES, settings=settings,
+                             progress=None if args.quiet else stage, seed_progress=bar)
+    finally:
+        if bar is not None:
+            bar.close()
 
 
 def _progress_bar(args: argparse.Namespace, settings,
@@ -110,9 +116,14 @@ def _progress_bar(args: argparse.Namespace, settings,
                file=sys.stderr, leave=False)
 
     def progress(done: int, total: int, run) -> None:
+        if total > bar.total:           # the global phase's runs after the seeds
+            bar.total = total
+            bar.set_description('GAASS seeds, global phase')
         bar.update(1)
-        bar.set_postfix_str(f'seed {run.seed}: %e_r {run.er_percent:.3f}')
+        bar.set_postfix_str(f'{"run" if run.seed < 0 else "seed"} {run.seed}: '
+                            f'%e_r {run.er_percent:.3f}')
         if bar.n >= bar.total:
             bar.close()
 
+    progress.close = bar.close          # the global phase may end before its most runs
     return progress

@@ -354,7 +354,9 @@ def identify(recording: Recording, *, spec: ChainSpec | None = None,
     settings : IdentifySettings, optional
         GAASS and refinement settings; default the paper's.
     progress : callable, optional
-        Called as ``progress(done, total, seed_run)`` after each seed.
+        Called as ``progress(done, total, seed_run)`` after each seed, then
+        after each run of the global phase (seeds ``-1``, ``-2``, ...; ``total``
+        then counts the most global runs there can be).
     on_generation : callable, optional
         Called as ``on_generation(seed, restart, generation, er_percent)``
         after every GAASS generation, when the seeds run in this process
@@ -413,8 +415,15 @@ def identify(recording: Recording, *, spec: ChainSpec | None = None,
                        for seed in settings.seeds], n_workers,
             on_result=on_result, should_stop=should_stop)
     best = min(runs, key=lambda r: r.fun)
+    n_done = [len(runs)]
+
+    def on_global_run(run: SeedRun) -> None:   # the bar grows by the global runs' most
+        n_done[0] += 1
+        if progress:
+            progress(n_done[0], len(settings.seeds) + settings.global_runs, run)
     runs += global_phases(spec, others, rec, settings, best, floor, n_workers, should_stop,
-                          subset=search_subset(rec.command, settings.search_samples))
+                          subset=search_subset(rec.command, settings.search_samples),
+                          on_run=on_global_run)
     ident = summarise(rec, spec, settings, runs)
     warnings, ident.poorly_determined = assess(ident, rec, spec)
     ident.warnings += warnings

@@ -107,7 +107,8 @@ def global_phase(spec: ChainSpec, rec: Recording, settings: IdentifySettings,
 def global_phases(spec: ChainSpec, others: list[ChainSpec], rec: Recording,
                   settings: IdentifySettings, best: SeedRun, floor_percent: float,
                   n_workers: int = 1, should_stop: Callable[[], bool] | None = None,
-                  subset: np.ndarray | None = None) -> list[SeedRun]:
+                  subset: np.ndarray | None = None,
+                  on_run: Callable[[SeedRun], None] | None = None) -> list[SeedRun]:
     """The global phase's runs that improved on ``best``, in the order they did.
 
     Parameters
@@ -130,6 +131,8 @@ def global_phases(spec: ChainSpec, others: list[ChainSpec], rec: Recording,
         As for :func:`~hyst_id.identification.workers.map_in_processes`.
     subset : numpy.ndarray, optional
         Sample indices the searches see on a long record (:func:`global_phase`).
+    on_run : callable, optional
+        Called with every run as its round ends (it may raise to stop).
     """
     if not (settings.refine and settings.global_evals > 0 and settings.global_runs > 0):
         return []
@@ -160,6 +163,8 @@ def global_phases(spec: ChainSpec, others: list[ChainSpec], rec: Recording,
         else:
             results = [global_phase(*t) for t in tasks]
         for run in results:        # in task order: ties go to the earlier run
+            if on_run is not None:
+                on_run(run)
             if run.fun < best.fun:
                 improved.append(run)
                 best = run

@@ -168,17 +168,20 @@ class IdentificationJob(BackgroundJob):
         self.check_cancelled()
 
     def progress(self) -> dict[str, Any]:
-        """Seeds done, best %e_r so far, elapsed time; the running seed's generation.
+        """Seeds and global runs done, best %e_r so far, elapsed time; the seed's generation.
 
         The generation is known when the seeds run in the job's own thread
         (``workers == 1``); a cancel then stops within one generation.
         """
         runs = self.runs
-        out: dict[str, Any] = {'seeds_done': len(runs), 'seeds': len(self.seeds),
+        seeds = [r for r in runs if r.seed >= 0]
+        out: dict[str, Any] = {'seeds_done': len(seeds), 'seeds': len(self.seeds),
                                'elapsed_s': self.elapsed_s}
+        if len(runs) > len(seeds):          # the global phase's runs after the seeds
+            out['global_runs_done'] = len(runs) - len(seeds)
         if runs:
             out['best_er_percent'] = min(r.er_percent for r in runs)
-        if self.generation and len(runs) < len(self.seeds):
+        if self.generation and len(seeds) < len(self.seeds):
             out.update(self.generation)
         return out
 

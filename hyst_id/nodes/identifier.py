@@ -137,9 +137,8 @@ class Identifier(HystNode):
                        TopicConfig.for_channel(self.channel).measurement_unit)
         self.params_out = Path(v['params_out']).expanduser() if v['params_out'] \
             else default_params_out()
-        # Best effort like every sensor subscriber, but with a deep queue: samples that
-        # arrive while the executor is busy (GIL held by a worker thread or the JIT
-        # warm-up) wait in the queue instead of being dropped. Reliable (replays): keep all.
+        # Best effort like every sensor subscriber, with a deep queue: samples arriving while
+        # the executor is busy (GIL, JIT warm-up) wait, not dropped. Reliable (replays): all.
         meas_qos = (QoSProfile(history=HistoryPolicy.KEEP_ALL,
                                reliability=ReliabilityPolicy.RELIABLE)
                     if v['measurement_reliable'] else
@@ -475,9 +474,10 @@ class Identifier(HystNode):
         if self.job is not None:
             prog = self.job.progress()
             values.update(prog)
-            msg = (f'identifying: {prog["seeds_done"]}/{prog["seeds"]} seeds done, '
-                   f'{prog["elapsed_s"]:.1f} s' + (f', best %e_r {prog["best_er_percent"]:.3f}'
-                                                   if 'best_er_percent' in prog else ''))
+            best, runs = prog.get('best_er_percent'), prog.get('global_runs_done', 0)
+            msg = (f'identifying: {prog["seeds_done"]}/{prog["seeds"]} seeds, {runs} global '
+                   f'runs, {prog["elapsed_s"]:.1f} s' + ('' if best is None else
+                                                         f', best %e_r {best:.3f}'))
             if 'generation' in prog:
                 msg += (f'; seed {prog["seed"]} run {prog["restart"] + 1} generation '
                         f'{prog["generation"]}, %e_r {prog["seed_er_percent"]:.3f}')

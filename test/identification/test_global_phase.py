@@ -67,7 +67,10 @@ def test_every_convention_before_longer_runs_under_the_best(calls):
     scores += [9.0, 8.0, 1.5, 7.0, 1.4, 1.3]          # never below 1.1 x a floor of 1
     best = _run(replace(spec, initial='rising', hold='before'), 10.0)
     settings = IdentifySettings(global_evals=1000)
-    improved = gp.global_phases(spec, _others(spec), None, settings, best, 1.0)
+    seen = []
+    improved = gp.global_phases(spec, _others(spec), None, settings, best, 1.0,
+                                on_run=lambda run: seen.append(run.seed))
+    assert seen == [-1, -2, -3, -4, -5, -6]
     # the best run's conventions, then each other once, then 3 x longer under the best so far
     assert [m[:2] for m in made] == [('rising', 'before'), ('falling', 'before'),
                                      ('rising', 'after'), ('falling', 'after'),
@@ -159,3 +162,19 @@ def test_a_long_record_is_searched_on_its_subset_and_scored_on_every_sample():
     run = gp.global_phase(spec, rec, settings, 0, -1, subset=sub)
     full = spec.cost_function(rec.t_s, rec.command, rec.measurement)(run.x_raw[None, :])[0]
     assert run.fun == pytest.approx(full, rel=1e-9)
+
+
+def test_identify_reports_each_global_run_after_its_seeds():
+    """A fit the chain cannot make (a slow drift added): one seed, then both conventions."""
+    t = np.arange(600) * 0.05
+    v = 9.0 + 3.0 * np.sin(2 * np.pi * t / 6.0)
+    y = np.tanh(v - 9.0) + 0.5 * np.sin(2 * np.pi * t / 30.0)
+    y = y + np.random.default_rng(0).normal(0.0, 0.002, t.size)
+    rec = Recording(t, v, y, 'position', 'mA', 'mm', 'drift the chain lacks')
+    calls = []
+    ident = identify(rec, settings=IdentifySettings(
+        seeds=(0,), maxiter=20, restarts=0, workers=1, global_evals=3000, global_runs=4),
+        progress=lambda done, total, run: calls.append((done, total, run.seed)))
+    assert ident.er_percent > 1.5 * ident.noise_floor_percent     # no longer runs
+    # position: two initial states, no sensor hold; the bar's total counts the most runs
+    assert calls == [(1, 1, 0), (2, 5, -1), (3, 5, -2)]
