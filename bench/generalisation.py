@@ -287,7 +287,7 @@ def run_case(index: int, methods: tuple[str, ...], seeds: int,
         more = {} if global_runs is None else {'global_runs': global_runs}
         ident = identify(rec, settings=IdentifySettings(seeds=tuple(range(seeds)), workers=1,
                                                         **more))
-        nfev = sum(run.nfev for run in ident.runs)
+        nfev = ident.nfev          # with the global runs that did not improve
         out['identify'] = (ident.er_percent / floor, nfev,
                            time.perf_counter() - t0)
         budget = nfev

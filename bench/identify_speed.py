@@ -64,7 +64,7 @@ def main(argv: list[str] | None = None) -> int:
         walls.append(wall)
         ratios.append(ratio)
         print(f'#{index:3d} {case.channel:8s} {case.excitation:13s} {wall:5.1f} s  '
-              f'{sum(r.nfev for r in ident.runs):7d} evaluations  {ratio:.3f} x the true floor',
+              f'{ident.nfev:7d} evaluations  {ratio:.3f} x the true floor',
               flush=True)
     walls, ratios = np.array(walls), np.array(ratios)
     print()

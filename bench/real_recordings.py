@@ -117,7 +117,7 @@ def run_one(rec, seeds: int, seed: int = 0) -> dict:
         ident = identify(train, settings=IdentifySettings(seeds=tuple(range(seeds)), workers=1))
         wall = time.perf_counter() - t0
         pred = ident.spec().simulate(ident.x, rec.t_s, rec.command)
-        budget = sum(run.nfev for run in ident.runs)
+        budget = ident.nfev
         out['identify'] = {'train': _er(yt, pred[:n_train]), 'holdout': _er(yh, pred[n_train:]),
                            'nfev': budget, 'wall_s': wall}
         spec = replace(domains_from_data(train), initial=ident.initial, hold=ident.hold)

@@ -173,6 +173,9 @@ class Identification:
     initial, hold : str
         The chain's initial state and sensor hold convention
         (:attr:`hyst_id.identification.chains.ChainSpec.initial`, ``.hold``).
+    other_nfev : int
+        Evaluations of global-phase runs that did not improve (not in ``runs``);
+        :attr:`nfev` counts them with the runs'.
     """
 
     channel: str
@@ -195,6 +198,12 @@ class Identification:
     family: str = 'tk'
     initial: str = 'rising'
     hold: str = 'before'
+    other_nfev: int = 0
+
+    @property
+    def nfev(self) -> int:
+        """Every evaluation made: the runs' and the global phase's that did not improve."""
+        return int(sum(r.nfev for r in self.runs)) + int(self.other_nfev)
 
     @property
     def x(self) -> np.ndarray:
@@ -223,7 +232,7 @@ class Identification:
                             'note': 'canonical gauge: H output in measurement units '
                             '(negated when output_sign is -1), backlash unit slope '
                             'centred on 0'},
-            'er_percent': self.er_percent,
+            'er_percent': self.er_percent, 'nfev': self.nfev,
             'er_mean_params_percent': self.er_mean_params_percent,
             'er_seeds_percent': [r.er_percent for r in self.runs],
             'noise_floor_percent': self.noise_floor_percent,

@@ -171,10 +171,16 @@ def test_identify_reports_each_global_run_after_its_seeds():
     y = np.tanh(v - 9.0) + 0.5 * np.sin(2 * np.pi * t / 30.0)
     y = y + np.random.default_rng(0).normal(0.0, 0.002, t.size)
     rec = Recording(t, v, y, 'position', 'mA', 'mm', 'drift the chain lacks')
-    calls = []
+    calls, reported = [], []
+
+    def progress(done, total, run):
+        calls.append((done, total, run.seed))
+        reported.append(run)
     ident = identify(rec, settings=IdentifySettings(
         seeds=(0,), maxiter=20, restarts=0, workers=1, global_evals=3000, global_runs=4),
-        progress=lambda done, total, run: calls.append((done, total, run.seed)))
+        progress=progress)
     assert ident.er_percent > 1.5 * ident.noise_floor_percent     # no longer runs
     # position: two initial states, no sensor hold; the bar's total counts the most runs
     assert calls == [(1, 1, 0), (2, 5, -1), (3, 5, -2)]
+    # every evaluation counts, also a global run's that did not improve (not in runs)
+    assert ident.nfev == sum(r.nfev for r in reported) >= sum(r.nfev for r in ident.runs)
