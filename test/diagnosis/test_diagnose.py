@@ -295,14 +295,12 @@ def test_a_supply_is_not_physics_of_the_position_reading():
     assert 'supply_decay' not in by_channel['position']
     assert 'supply_decay' in by_channel['pressure'] and 'supply_decay' in by_channel['flow']
     assert set(by_channel['position']) == set(MECHANISM_IDS) - {'supply_decay'}
-    # where no supply reaches, a gain may fall as well as grow; elsewhere falling is supply's
+    # a gain drift keeps a growth above zero on every channel: near zero with a distant
+    # zero b0 it would be an offset drift (a synthetic offset drift on position was named
+    # gain_drift with 0.03 % of growth when the bound was dropped)
     t = np.arange(100.0)
-    for ch, signed in (('position', True), ('pressure', False), ('flow', False)):
-        ctx = Context(ch, t, 70)
-        gd = MECHANISMS['gain_drift']
-        assert (gd.bounds(ctx)[0, 0] < 0) == signed
-        assert gd.bounds(ctx)[0, 0] <= gd.null(ctx)[0] <= gd.bounds(ctx)[0, 1]
-        assert any(s[0] < 0 for s in gd.starts(ctx)) == signed
+    for ch in ('position', 'pressure', 'flow'):
+        assert MECHANISMS['gain_drift'].bounds(Context(ch, t, 70))[0, 0] > 0
 
 
 def test_cli_errors_are_one_line(tmp_path, capsys):
