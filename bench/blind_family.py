@@ -38,6 +38,7 @@ writes ``docs/diagnosis_blind.md`` and ``docs/diagnosis_blind.json``.
 Run from the repository root (about 30 minutes for 150 recordings on 2 cores)::
 
     python bench/blind_family.py [--n 150] [--workers 2] [--no-write]
+    python bench/blind_family.py --indices 38 42 64      # some recordings again, no write
     python bench/blind_family.py --from-json     # the tables again, from the last run
 """
 
@@ -217,6 +218,8 @@ def main() -> int:
     ap.add_argument('--n', type=int, default=150)
     ap.add_argument('--workers', type=int, default=2)
     ap.add_argument('--no-write', action='store_true')
+    ap.add_argument('--indices', type=int, nargs='+', metavar='I',
+                    help='only these recordings (implies --no-write)')
     ap.add_argument('--from-json', action='store_true',
                     help='only reprint the tables from docs/diagnosis_blind.json')
     args = ap.parse_args()
@@ -224,17 +227,18 @@ def main() -> int:
         print(summary(json.loads((ROOT / 'docs' / 'diagnosis_blind.json').read_text())))
         return 0
     rows, t0 = [], time.time()
+    indices = args.indices or list(range(args.n))
     with ProcessPoolExecutor(args.workers) as pool:
-        for r in pool.map(run, range(args.n)):
+        for r in pool.map(run, indices):
             rows.append(r)
-            print(f'[{len(rows)}/{args.n} {time.time() - t0:.0f} s] #{r["index"]} '
+            print(f'[{len(rows)}/{len(indices)} {time.time() - t0:.0f} s] #{r["index"]} '
                   f'{r["channel"]} {r["excitation"]} {1 / r["dt_s"]:g} Hz '
                   f'{"+".join(r["effects"]) or "clean"} (cost {r["cost"]:.1f} x) -> '
                   f'{"+".join(r["found"]) or r["verdict"]} (final {r["final"]:.2f} x, '
                   f'{r["seconds"]:.0f} s)', flush=True)
     text = summary(rows)
     print(text)
-    if not args.no_write:
+    if not (args.no_write or args.indices):
         (ROOT / 'docs' / 'diagnosis_blind.json').write_text(json.dumps(rows, indent=1))
         (ROOT / 'docs' / 'diagnosis_blind.md').write_text(
             '# Blind diagnosis on the reference family (issue 14)\n\nWritten by '
