@@ -415,19 +415,18 @@ def identify(recording: Recording, *, spec: ChainSpec | None = None,
                        for seed in settings.seeds], n_workers,
             on_result=on_result, should_stop=should_stop)
     best = min(runs, key=lambda r: r.fun)
-    n_done, global_nfev = [len(runs)], [0]
+    global_runs: list[SeedRun] = []
 
     def on_global_run(run: SeedRun) -> None:   # the bar grows by the global runs' most
-        n_done[0] += 1
-        global_nfev[0] += run.nfev
+        global_runs.append(run)
         if progress:
-            progress(n_done[0], len(settings.seeds) + settings.global_runs, run)
+            progress(len(runs) + len(global_runs), len(settings.seeds) + settings.global_runs,
+                     run)
     improved = global_phases(spec, others, rec, settings, best, floor, n_workers, should_stop,
                              subset=search_subset(rec.command, settings.search_samples),
                              on_run=on_global_run)
-    runs += improved
-    ident = summarise(rec, spec, settings, runs)
-    ident.other_nfev = global_nfev[0] - sum(r.nfev for r in improved)
+    ident = summarise(rec, spec, settings, runs + improved)
+    ident.other_nfev = sum(r.nfev for r in global_runs) - sum(r.nfev for r in improved)
     warnings, ident.poorly_determined = assess(ident, rec, spec)
     ident.warnings += warnings
     return ident

@@ -57,7 +57,8 @@ _LONG_RUN = 3
 
 #: The longer runs only while the best fit is within this multiple of the floor: further
 #: off, what is missing is more likely physics the chain lacks (a real recording) than a
-#: trap; on the reference family every miss they fixed was at 1.29-1.48 x.
+#: trap; on the reference family every miss they fixed was at 1.17-1.48 x before them
+#: (#84, #40, #47, #2: docs/data/generalisation_*global_runs*.jsonl).
 LONG_RUNS_WITHIN = 1.5
 
 

@@ -77,9 +77,10 @@ class IdentifySettings:
         the estimated noise floor, runs of scipy's differential evolution
         over the whole box, each refined, join the runs (seeds ``-1``,
         ``-2``, ...) when they do better: one per initial state and sensor
-        hold convention with this many evaluations, then runs with three
-        times as many under the best fit's conventions, in rounds of two
-        until the fit reaches ``global_factor`` or ``global_runs`` are spent
+        hold convention with this many evaluations, then, while the fit is
+        within 1.5 x the floor, runs with three times as many under the best
+        fit's conventions, in rounds of two until the fit reaches
+        ``global_factor`` or ``global_runs`` are spent
         (:mod:`hyst_id.identification.global_phase`). 0: off.
     global_factor : float
         The floor multiple above which the global phase runs.

@@ -26,6 +26,7 @@ from hyst_id.compensation.params_file import compensator_names
 from hyst_id.errors import RecordingError
 from hyst_id.identification import IdentifySettings
 from hyst_id.identification.chains import chain_spec
+from hyst_id.io.recording import Recording
 from hyst_id.live import (
     BackgroundJob,
     compensator_set,
@@ -133,6 +134,22 @@ def test_identification_job_reports_generations_and_cancels_within_a_seed():
     job.cancel()
     assert job.wait(30.0)            # 100000 generations would take minutes
     assert job.cancelled and not job.runs
+
+
+def test_identification_job_counts_global_runs_apart_from_seeds():
+    """A drift the chain cannot make keeps the fit above the floor: both global runs run."""
+    t = np.arange(600) * 0.05
+    v = 9.0 + 3.0 * np.sin(2 * np.pi * t / 6.0)
+    y = np.tanh(v - 9.0) + 0.5 * np.sin(2 * np.pi * t / 30.0)
+    rec = Recording(t, v, y + np.random.default_rng(0).normal(0.0, 0.002, t.size), 'position',
+                    'mA', 'mm', 'drift')
+    settings = IdentifySettings(seeds=(0,), maxiter=20, restarts=0, workers=1,
+                                global_evals=3000, global_runs=2)
+    job = IdentificationJob(rec, None, settings)
+    assert job.wait(120.0) and job.error is None
+    prog = job.progress()
+    assert prog['seeds_done'] == 1 and prog['seeds'] == 1 and prog['global_runs_done'] == 2
+    assert prog['best_er_percent'] == pytest.approx(job.result.er_percent)
 
 
 def test_background_job_errors_are_one_line():

@@ -67,13 +67,11 @@ class GainDrift(TimeGain):
 
     def explain(self, values, where, ctx) -> str:
         """Words for a control engineer."""
-        growth = values['gain_growth_percent'].value
-        way, more = ('grows', 'more') if growth >= 0 else ('falls', 'less')
-        return (f'The gain {way} with time: {abs(growth):.1f} % over '
+        return (f'The gain grows with time: {values["gain_growth_percent"].value:.1f} % over '
                 f'the {ctx.duration_s:.0f} s record '
-                f'({values["growth_percent_per_s"].value:+.3g} %/s): the same travel reads '
-                f'{more} {ctx.channel} later in the run, as when a sensor or its amplifier '
-                'warms up. Let the sensor warm up before identifying, calibrate at operating '
+                f'({values["growth_percent_per_s"].value:.3g} %/s): the same travel reads '
+                f'more {ctx.channel} later in the run, as when a sensor or its amplifier warms '
+                'up. Let the sensor warm up before identifying, calibrate at operating '
                 'temperature, or track the gain online (tracking in the compensator).')
 
 
