@@ -135,19 +135,29 @@ def test_the_same_runs_with_one_or_two_workers():
         np.testing.assert_array_equal(a.x_raw, b.x_raw)
 
 
-@pytest.mark.slow
-def test_the_sweep_finds_the_convention_the_ranking_missed():
-    """Reference family #104: a run under the third or fourth convention reaches the floor.
+def test_identify_sweeps_every_convention_of_a_sensor_channel():
+    """Flow: two initial states x two sensor holds, each once, the best-ranked first.
 
-    11.1 x the true floor after the runs under the two best-ranked conventions;
-    a run under one of the other two reaches 1.06 x (``bench/generalisation.py``,
-    docs/benchmarks.md).
+    Which run finds a trapped fit's basin is luck of its stream and the last
+    bits (family #104 reached 1.06 x under one probe and stayed at 11.3 x under
+    another), so what is asserted is that every convention is searched.
     """
-    case = FAMILY.draw_case(104)
-    rec = Recording(case.t_s, case.command, case.measurement, case.channel, 'u', 'y', '#104')
-    ident = identify(rec, settings=IdentifySettings(workers=1))
-    assert ident.er_percent / FAMILY.true_floor(case) <= 1.1
-    assert min(r.seed for r in ident.runs if r.er_percent == ident.er_percent) <= -3
+    t = np.arange(600) * 0.05
+    v = 9.0 + 3.0 * np.sin(2 * np.pi * t / 6.0)
+    y = np.tanh(v - 9.0) + 0.5 * np.sin(2 * np.pi * t / 30.0)
+    rec = Recording(t, v, y + np.random.default_rng(1).normal(0.0, 0.002, t.size), 'flow',
+                    'mA', 'g/s', 'drift the chain lacks')
+    seen = []
+    ident = identify(rec, settings=IdentifySettings(
+        seeds=(0,), maxiter=20, restarts=0, workers=1, global_evals=3000, global_runs=6),
+        progress=lambda done, total, run: seen.append(run))
+    glob = [r for r in seen if r.seed < 0]
+    assert ident.er_percent > 1.5 * ident.noise_floor_percent     # no longer runs
+    assert [r.seed for r in glob] == [-1, -2, -3, -4]
+    assert {(r.initial, r.hold) for r in glob} == {(i, h) for i in ('rising', 'falling')
+                                                   for h in ('before', 'after')}
+    assert (glob[0].initial, glob[0].hold) == (seen[0].initial, seen[0].hold)
+    assert ident.er_percent <= seen[0].er_percent
 
 
 def test_a_long_record_is_searched_on_its_subset_and_scored_on_every_sample():
