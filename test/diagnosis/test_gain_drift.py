@@ -26,6 +26,7 @@ import pytest
 from reference_sim import backlash, hysteresis
 
 from hyst_id.diagnosis import diagnose, DiagnoseSettings
+from hyst_id.diagnosis.mechanisms.base import Context
 from hyst_id.diagnosis.mechanisms.registry import MECHANISMS
 from hyst_id.io.recording import Recording
 
@@ -71,3 +72,18 @@ def test_a_steady_gain_claims_no_drift():
     d = diagnose(_recording(5, lambda t: np.ones_like(t)), settings=SETTINGS)
     found = {f.mechanism for f in d.findings}
     assert not found & {'gain_drift', 'supply_decay', 'offset_drift'}, found
+
+
+@pytest.mark.parametrize('mech', ['gain_drift', 'supply_decay'])
+def test_a_rate_at_the_slowest_end_is_not_a_changing_gain(mech):
+    """At its slowest rate the block is an offset ramp ``g(t) b0`` (probe 3 named one so)."""
+    m = MECHANISMS[mech]
+    t = np.arange(2400) * 0.05
+    ctx = Context('pressure', t, 1680)
+    slowest = float(m.bounds(ctx)[0, 0])
+    coef, span = np.array([40.0, 900.0, 100.0]), (0.0, 12.0)
+    assert 'offset drift' in m.implausible(np.array([slowest]), coef, span, 0.01, ctx)
+    assert 'slowest end' in m.implausible(np.array([1.04 * slowest]), coef, span, 0.01, ctx)
+    assert m.implausible(np.array([1.2 * slowest]), coef, span, 0.01, ctx) == ''
+    assert m.implausible(np.array(m.starts(ctx)[0]), coef, span, 0.01, ctx) == ''
+    assert m.implausible(np.array([slowest]), coef, span, 0.01) == ''     # no bounds known

@@ -31,7 +31,10 @@ import numpy as np
 
 from hyst_id.diagnosis.mechanisms.base import Context, Mechanism
 
-__all__ = ['TimeGain']
+__all__ = ['AT_SLOWEST', 'TimeGain']
+
+#: A fitted rate within this factor of the slowest one searched is at the bound.
+AT_SLOWEST = 1.05
 
 
 class TimeGain(Mechanism):
@@ -65,6 +68,23 @@ class TimeGain(Mechanism):
     def null(self, ctx: Context) -> np.ndarray:
         """Slowest change (the block is then nearly the identity)."""
         return self.bounds(ctx)[:, 0].copy()
+
+    def implausible(self, theta, coef, span, noise_std, ctx=None) -> str:
+        """A rate at the slowest end of its search is not a gain that changes.
+
+        There the fit wanted a still smaller change of a still more distant
+        gained offset ``b0``: ``g(t) b0`` is then a ramp added to the
+        reading, the same at every level, which is an offset drift.
+        """
+        if ctx is None:
+            return ''
+        slowest = float(self.bounds(ctx)[0, 0])
+        if float(theta[0]) <= AT_SLOWEST * slowest:
+            change = 100.0 * float(theta[0]) * ctx.train_duration_s
+            return (f'its rate ({change:.2g} % over the training part) sits at the slowest '
+                    'end of its search, where a gain change about a distant zero is an offset '
+                    'drift')
+        return ''
 
     def output(self, theta, t_s, columns, ctx) -> list[np.ndarray]:
         """The gain on every signal column, plus the gained offset ``g(t)``."""
