@@ -130,9 +130,10 @@ def draw(index: int) -> dict:
     y = y + rng.normal(0.0, sigma, y.size)
     a, b = float(np.exp(rng.uniform(np.log(0.5), np.log(5.0)))), float(rng.uniform(-5, 5))
     k = float(np.exp(rng.uniform(np.log(0.1), np.log(100.0))))
+    zero = rng.uniform(-10, 10) * k       # the reading of y = 0 (gain_drift's pivot)
     return {'index': index, 'channel': channel, 'excitation': kind, 'dt_s': dt,
             'effects': effects, 'magnitudes': mags, 't': t, 'command': a * v + b,
-            'measurement': k * y + rng.uniform(-10, 10) * k,
+            'measurement': k * y + zero, 'sensor_zero': zero,
             'noise_percent_of_span': 100.0 * sigma / span}
 
 
