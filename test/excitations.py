@@ -12,13 +12,13 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
-"""Test excitations shared by several test modules (plain numpy)."""
+"""Test excitations and recordings shared by several test modules (plain numpy)."""
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ['moves_and_holds']
+__all__ = ['moves_and_holds', 'off_chain_recording']
 
 
 def moves_and_holds(rng: np.random.Generator, t_s: np.ndarray, dwell_s: float, move_s: float,
@@ -34,3 +34,18 @@ def moves_and_holds(rng: np.random.Generator, t_s: np.ndarray, dwell_s: float, m
     prev = np.concatenate([[start], levels[:-1]])[seg]
     frac = np.clip((t_s % dwell_s) / move_s, 0.0, 1.0)
     return prev + (levels[seg] - prev) * frac
+
+
+def off_chain_recording(channel: str, seed: int):
+    """A sine run whose response has a slow drift no chain makes (fits stay above the floor).
+
+    600 samples at 20 Hz, a 6 s sine about 9 mA, ``tanh`` of the command
+    plus a 30 s drift of half its size, and 0.002 of white noise: what makes
+    the global phase run every global run it is given.
+    """
+    from hyst_id.io.recording import Recording
+    t = np.arange(600) * 0.05
+    v = 9.0 + 3.0 * np.sin(2 * np.pi * t / 6.0)
+    y = np.tanh(v - 9.0) + 0.5 * np.sin(2 * np.pi * t / 30.0)
+    y = y + np.random.default_rng(seed).normal(0.0, 0.002, t.size)
+    return Recording(t, v, y, channel, 'mA', 'mm', 'drift the chain lacks')

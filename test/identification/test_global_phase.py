@@ -21,6 +21,7 @@ import importlib
 from pathlib import Path
 import sys
 
+from excitations import off_chain_recording
 import numpy as np
 import pytest
 
@@ -142,11 +143,7 @@ def test_identify_sweeps_every_convention_of_a_sensor_channel():
     bits (family #104 reached 1.06 x under one probe and stayed at 11.3 x under
     another), so what is asserted is that every convention is searched.
     """
-    t = np.arange(600) * 0.05
-    v = 9.0 + 3.0 * np.sin(2 * np.pi * t / 6.0)
-    y = np.tanh(v - 9.0) + 0.5 * np.sin(2 * np.pi * t / 30.0)
-    rec = Recording(t, v, y + np.random.default_rng(1).normal(0.0, 0.002, t.size), 'flow',
-                    'mA', 'g/s', 'drift the chain lacks')
+    rec = off_chain_recording('flow', seed=1)
     seen = []
     ident = identify(rec, settings=IdentifySettings(
         seeds=(0,), maxiter=20, restarts=0, workers=1, global_evals=3000, global_runs=6),
@@ -176,11 +173,7 @@ def test_a_long_record_is_searched_on_its_subset_and_scored_on_every_sample():
 
 def test_identify_reports_each_global_run_after_its_seeds():
     """A fit the chain cannot make (a slow drift added): one seed, then both conventions."""
-    t = np.arange(600) * 0.05
-    v = 9.0 + 3.0 * np.sin(2 * np.pi * t / 6.0)
-    y = np.tanh(v - 9.0) + 0.5 * np.sin(2 * np.pi * t / 30.0)
-    y = y + np.random.default_rng(0).normal(0.0, 0.002, t.size)
-    rec = Recording(t, v, y, 'position', 'mA', 'mm', 'drift the chain lacks')
+    rec = off_chain_recording('position', seed=0)
     calls, reported = [], []
 
     def progress(done, total, run):

@@ -19,6 +19,7 @@ from __future__ import annotations
 import math
 from types import SimpleNamespace
 
+from excitations import off_chain_recording
 import numpy as np
 import pytest
 
@@ -26,7 +27,6 @@ from hyst_id.compensation.params_file import compensator_names
 from hyst_id.errors import RecordingError
 from hyst_id.identification import IdentifySettings
 from hyst_id.identification.chains import chain_spec
-from hyst_id.io.recording import Recording
 from hyst_id.live import (
     BackgroundJob,
     compensator_set,
@@ -138,11 +138,7 @@ def test_identification_job_reports_generations_and_cancels_within_a_seed():
 
 def test_identification_job_counts_global_runs_apart_from_seeds():
     """A drift the chain cannot make keeps the fit above the floor: both global runs run."""
-    t = np.arange(600) * 0.05
-    v = 9.0 + 3.0 * np.sin(2 * np.pi * t / 6.0)
-    y = np.tanh(v - 9.0) + 0.5 * np.sin(2 * np.pi * t / 30.0)
-    rec = Recording(t, v, y + np.random.default_rng(0).normal(0.0, 0.002, t.size), 'position',
-                    'mA', 'mm', 'drift')
+    rec = off_chain_recording('position', seed=0)
     settings = IdentifySettings(seeds=(0,), maxiter=20, restarts=0, workers=1,
                                 global_evals=3000, global_runs=2)
     job = IdentificationJob(rec, None, settings)
