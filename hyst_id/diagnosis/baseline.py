@@ -47,7 +47,8 @@ def structured_starts(spec: ChainSpec, t_s: np.ndarray, v: np.ndarray, y: np.nda
                        splits=splits, per_split=1)
 
 
-def baseline_starts(rec_train: Recording, spec: ChainSpec, settings, *, thorough: bool = True
+def baseline_starts(rec_train: Recording, spec: ChainSpec, settings, *, thorough: bool = True,
+                    global_phase: bool | None = None
                     ) -> tuple[list[np.ndarray], list[np.ndarray]]:
     """The best identified chains and the data-built starts.
 
@@ -66,13 +67,17 @@ def baseline_starts(rec_train: Recording, spec: ChainSpec, settings, *, thorough
     blind family claimed physics, with this one and the null control 3
     (bench/blind_family.py, docs/diagnosis.md). Otherwise (a family swap's
     refit) the quick search: GAASS seeds refined, given conventions.
+    ``global_phase`` (default: as ``thorough``) adds identify's global phase
+    (one run) to the quick search (the re-identification of a chain with its
+    accepted blocks undone, :mod:`hyst_id.diagnosis.refit`).
     """
     base = {'pop_size': settings.pop_size, 'maxiter': settings.generations,
             'seeds': tuple(settings.seeds), 'workers': settings.workers, 'refine': True,
             'refine_top': 2, 'restarts': 1, 'refine_max_nfev': 1500}
     runs = []
     for conventions in (('given', 'auto') if thorough else ('given',)):
-        global_evals = IdentifySettings.global_evals if thorough else 0   # identify's default
+        use_global = thorough if global_phase is None else global_phase
+        global_evals = IdentifySettings.global_evals if use_global else 0   # identify's default
         # one global run in the given conventions, two (best and runner-up) in 'auto'
         ident = identify(rec_train, spec=spec, settings=IdentifySettings(
             **base, conventions=conventions, global_evals=global_evals,

@@ -24,14 +24,21 @@ the block, polishes that chain in the current model with the same budget, and
 judges every accepted block again against it (:func:`hyst_id.diagnosis.select.compare`).
 A block that is no longer accepted was the refit's doing; the refit, better on
 the training part, then becomes the current model.
+
+:func:`drop_superseded` is the same question asked backwards at the end: with
+two or more blocks, is each still needed once the others are in? A block
+accepted early against a chain the missing effect had biased can be made
+redundant by a later one (an offset ramp taken first for a gain that grows
+about a distant zero, the gain drift added next then explains both).
 """
 
 from __future__ import annotations
 
+from hyst_id.diagnosis.model import ComposedModel
 from hyst_id.diagnosis.select import compare, Comparison, Criteria, Data, evaluate, FitResult
 from hyst_id.diagnosis.select import polish
 
-__all__ = ['null_control', 'recheck']
+__all__ = ['drop_superseded', 'null_control', 'recheck']
 
 
 def null_control(candidate: Comparison, current: FitResult, data: Data, *,
@@ -70,3 +77,45 @@ def recheck(comparisons: list[Comparison], null: FitResult, data: Data,
             c.accepted, c.status = False, 'rejected: the chain refit alone does as well'
             lost += 1
     return lost
+
+
+def drop_superseded(current: FitResult, order: list[str], data: Data, criteria: Criteria,
+                    *, max_nfev: int) -> tuple[FitResult, list[str]]:
+    """Withdraw blocks the others make redundant (backward elimination).
+
+    Each block of ``current`` (in ``order``, the order they were accepted) is
+    taken out, the rest is polished from the current values, and the model
+    with the block is judged against the one without it by the acceptance
+    criteria (:func:`hyst_id.diagnosis.select.compare`). A block that is no
+    longer accepted is withdrawn, the reduced model becomes the current one,
+    and the check starts again; the last block is kept (it was accepted
+    against the model before it).
+
+    Returns
+    -------
+    FitResult
+        The model without the withdrawn blocks.
+    list of str
+        The ids withdrawn, in the order they were.
+    """
+    dropped: list[str] = []
+    while current.model is not None and len(current.model.mechanisms) > 1:
+        prev = current.model
+        for mid in [i for i in order if i in prev.slices and i not in dropped]:
+            keep = [m for m in prev.mechanisms if m.id != mid]
+            model = ComposedModel(prev.channel, keep, prev.ctx, prev.bounds[:prev.n_chain],
+                                  family=prev.spec.family.id, swapped_by=prev.swapped_by,
+                                  hold=prev.hold)
+            p0 = model.pack(current.p[:prev.n_chain],
+                            {m.id: prev.theta(current.p, m.id) for m in keep})
+            if not model.feasible(p0):
+                continue
+            p, _, nfev = polish(model, data, p0, max_nfev=max_nfev)
+            reduced = evaluate(model, data, p, nfev)
+            if not compare(reduced, current, data, mid, criteria).accepted:
+                current = reduced
+                dropped.append(mid)
+                break
+        else:
+            break
+    return current, dropped

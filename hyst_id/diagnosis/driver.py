@@ -48,12 +48,13 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from hyst_id.diagnosis.baseline import baseline_starts
-from hyst_id.diagnosis.control import null_control, recheck
+from hyst_id.diagnosis.control import drop_superseded, null_control, recheck
 from hyst_id.diagnosis.empirical import empirical_block
 from hyst_id.diagnosis.locate import Localization, locate, noise_std
 from hyst_id.diagnosis.mechanisms import get_mechanisms
 from hyst_id.diagnosis.mechanisms.base import Context, Mechanism
 from hyst_id.diagnosis.model import ComposedModel, held
+from hyst_id.diagnosis.refit import reidentify
 from hyst_id.diagnosis.result import DiagnoseSettings, Diagnosis, Finding
 from hyst_id.diagnosis.select import (
     alternatives_record,
@@ -255,11 +256,22 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
         findings.append(finding_from(winner, current, mech, loc, ctx, v_orig))
         findings[-1].alternatives = alternatives_record(
             tied, close_calls(comps, winner, tied, data, settings.criteria), data)
-        current = winner.fit
+        current = _reidentified(winner, findings[-1], data, ctx, spec, settings, floor_t, say)
         loc = locate(t, v_orig, y, current.prediction, sigma, n_train, ctx.period_s)
+    notes = list(rec.notes) + range_note(v_orig, n_train, data.judged_rows.size)
+    if len(findings) > 1:
+        current, dropped = drop_superseded(current, [f.mechanism for f in findings], data,
+                                           settings.criteria, max_nfev=2 * settings.fit_budget)
+        for mid in dropped:
+            say(f'{mid} withdrawn: the other blocks explain what it did')
+            notes.append(f'{mid} was accepted in its round and withdrawn at the end: with the '
+                         'other blocks in, the model without it does as well on held-out data '
+                         '(it stood in for what a later block explains)')
+        if dropped:
+            findings = [f for f in findings if f.mechanism not in dropped]
+            loc = locate(t, v_orig, y, current.prediction, sigma, n_train, ctx.period_s)
     _final_corrections(findings, mechs, current, ctx, v_orig)
     final_loc = loc if current is not baseline else loc0
-    notes = list(rec.notes) + range_note(v_orig, n_train, data.judged_rows.size)
     empirical = None
     if current.er_holdout_percent > UNKNOWN_FACTOR * floor_h:
         say('empirical block: what a model could still gain')
@@ -282,6 +294,19 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
                                          'hold': current.model.hold
                                          if current.model.dynamic else '',
                                          'judged_holdout': _judged(data, baseline, current)})
+
+
+def _reidentified(winner: Comparison, finding: Finding, data: Data, ctx: Context,
+                  spec: ChainSpec, settings: DiagnoseSettings, floor_t: float,
+                  say: Callable[[str], None]) -> FitResult:
+    """The accepted fit, or the whole chain re-identified with its blocks (refit module)."""
+    again = reidentify(winner.fit, data, ctx, spec, settings, floor_train_percent=floor_t)
+    if again is not winner.fit:
+        say(f're-identified the chain with {winner.mechanism}: training %e_r '
+            f'{winner.fit.er_train_percent:.4g} -> {again.er_train_percent:.4g}')
+        finding.er_train_after_percent = again.er_train_percent
+        finding.er_holdout_after_percent = again.er_holdout_percent
+    return again
 
 
 def _final_corrections(findings: list[Finding], mechs: list[Mechanism], final: FitResult,

@@ -30,10 +30,10 @@ import numpy as np
 import pytest
 from reference_sim import simulate as reference_simulate
 
-from hyst_id.diagnosis.control import null_control, recheck
+from hyst_id.diagnosis.control import drop_superseded, null_control, recheck
 from hyst_id.diagnosis.mechanisms import Context, MECHANISMS
 from hyst_id.diagnosis.model import ComposedModel
-from hyst_id.diagnosis.select import compare, Criteria, Data, evaluate, fit_model
+from hyst_id.diagnosis.select import compare, Criteria, Data, evaluate, fit_model, polish
 from hyst_id.identification.chains import chain_spec
 from hyst_id.signals.excitation import multisine
 
@@ -74,3 +74,41 @@ def test_a_block_that_only_carried_the_refit_is_withdrawn(drift, withdrawn):
     if null is not None:
         assert recheck([comp], null, data, Criteria()) == withdrawn
     assert comp.accepted == (not withdrawn), comp.status
+
+
+def _two_blocks(effects: str, seed: int = 3):
+    """A record with two effects and the model with two blocks fitted from the truth.
+
+    ``'gain'``: a gain growing 0.08 %/s about a zero 8 travel units away, fitted with
+    ``offset_drift`` (accepted first) and ``gain_drift``; a free gain pivot makes the
+    ramp redundant. ``'delay+drift'``: a 0.3 s dead time and an offset ramp of 5 % of
+    the span, fitted with both blocks, each needed.
+    """
+    t = np.arange(0.0, 120.0, 0.05)
+    v = multisine(t, amplitude_ma=1.8)
+    ctx = Context('position', t, int(0.7 * t.size))
+    if effects == 'gain':
+        x = reference_simulate('position', dict(zip(NAMES, TRUTH)), t, v)
+        y = 30.0 * (x + 8.0) * (1.0 + 0.0008 * t)
+        ids, thetas = ('offset_drift', 'gain_drift'), {'gain_drift': [0.0008]}
+    else:
+        x = reference_simulate('position', dict(zip(NAMES, TRUTH)), t, np.interp(t - 0.3, t, v))
+        y = x + 0.05 * np.ptp(x) * t / t[-1]
+        ids, thetas = ('dead_time', 'offset_drift'), {'dead_time': [0.3]}
+    sigma = 0.004 * np.ptp(y)
+    y = y + np.random.default_rng(seed).normal(0.0, sigma, t.size)
+    data = Data(t_s=t, v=v, y=y, n_train=ctx.n_train, noise_std=sigma)
+    model = ComposedModel('position', [MECHANISMS[i] for i in ids], ctx,
+                          chain_spec('position').bounds)
+    p = polish(model, data, model.pack(TRUTH, thetas), max_nfev=1200)[0]
+    return data, ids, evaluate(model, data, p)
+
+
+@pytest.mark.parametrize('effects, dropped', [('gain', ['offset_drift']),
+                                              ('delay+drift', [])])
+def test_a_block_the_others_make_redundant_is_withdrawn_at_the_end(effects, dropped):
+    data, order, current = _two_blocks(effects)
+    final, out = drop_superseded(current, list(order), data, Criteria(), max_nfev=1200)
+    assert out == dropped
+    assert set(final.ids) == set(order) - set(dropped)
+    assert final.er_holdout_percent < 1.2 * data.floor_holdout_percent

@@ -237,6 +237,28 @@ class Mechanism:
         """Regressors of the linear calibration (last one is the constant)."""
         return columns
 
+    def undo(self, theta: np.ndarray, t_s: np.ndarray, v: np.ndarray, y: np.ndarray,
+             terms: dict[str, np.ndarray], ctx: Context
+             ) -> tuple[np.ndarray, np.ndarray] | None:
+        """The command and measurement with this block taken out, or ``None``.
+
+        What the chain alone would have been given and would have produced,
+        so that the chain can be searched again globally once the block is
+        accepted (:mod:`hyst_id.diagnosis.refit`). ``terms`` maps each
+        regressor label of the fitted model to its fitted contribution
+        (coefficient times column). By default a command-stage block is
+        applied to the command and an output-stage block's own terms are
+        subtracted from the measurement; blocks at the other stages are not
+        inverted (``None``): a filter's or an end stop's inverse applied to
+        noisy samples is no data.
+        """
+        if self.stage == 'command':
+            return self.command(theta, t_s, v), y
+        if self.stage == 'output':
+            own = [c for k, c in terms.items() if k.startswith(f'{self.id}:')]
+            return v, (y - np.sum(own, axis=0)) if own else y
+        return None
+
     # -- words -------------------------------------------------------------
     def describe(self, theta: np.ndarray, coef: np.ndarray, info: dict,
                  ctx: Context) -> dict[str, Quantity]:

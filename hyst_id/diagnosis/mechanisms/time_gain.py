@@ -91,6 +91,14 @@ class TimeGain(Mechanism):
         g = self.gain(float(theta[0]), t_s - ctx.t_s[0])
         return [c * g for c in columns[:-1]] + [g, columns[-1]]
 
+    def undo(self, theta, t_s, v, y, terms, ctx) -> tuple[np.ndarray, np.ndarray] | None:
+        """The gain divided out about the reading it leaves unchanged (the constant ``b1``)."""
+        g = self.gain(float(theta[0]), t_s - ctx.t_s[0])
+        if not np.all(g > 1e-3):
+            return None     # a gain through zero cannot be divided out
+        b1 = float(terms['offset'][0])
+        return v, (y - b1) / g + b1
+
     def evidence(self, loc) -> tuple[float, dict]:
         """A time trend whose size scales with the output level."""
         f = loc.features
