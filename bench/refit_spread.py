@@ -22,7 +22,11 @@ probes (the measurement perturbed by 1e-12 relative, another CPU's last
 bits): the local fit's and the re-identified fit's training %e_r over the
 training floor, the re-identified growth rate (truth 0.0008 /s) and the
 seconds the re-identification took, so that the test's seeds and bounds sit
-outside what the computation gives elsewhere.
+outside what the computation gives elsewhere. Then the backward check of
+``test/diagnosis/test_null_control.py`` (``control.drop_superseded``) over the
+same seeds and probes: what it withdrew from ``offset_drift`` + ``gain_drift``
+on a gain drift about a distant zero and from ``dead_time`` + ``offset_drift``
+on a record with both, and the final held-out %e_r over the floor.
 
 Run from the repository root (about five minutes on 2 cores)::
 
@@ -41,10 +45,13 @@ sys.path.insert(0, str(ROOT / 'test'))
 sys.path.insert(0, str(ROOT / 'test' / 'diagnosis'))
 sys.path.insert(0, str(ROOT))
 
-import test_refit as case  # noqa: E402, I100
+import test_null_control as pair  # noqa: E402, I100
+import test_refit as case  # noqa: E402
 
-from hyst_id.diagnosis.refit import reidentify  # noqa: E402, I100
+from hyst_id.diagnosis.control import drop_superseded  # noqa: E402, I100
+from hyst_id.diagnosis.refit import reidentify  # noqa: E402
 from hyst_id.diagnosis.result import DiagnoseSettings  # noqa: E402
+from hyst_id.diagnosis.select import Criteria  # noqa: E402
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -73,6 +80,17 @@ def main(argv: list[str] | None = None) -> int:
     print(f'\nlocal fits above {case.REFIT_ABOVE_TEST} x the floor: {len(stuck)} '
           f'({sorted({s for s, _ in stuck})} by seed); re-identified: '
           f'{min(after, default=float("nan")):.3f} - {max(after, default=float("nan")):.3f} x')
+    print('\n| pair | seed | probe | withdrawn | final held-out / floor |')
+    print('|---|---|---|---|---|')
+    for effects in ('gain', 'delay+drift'):
+        for seed in range(args.seeds):
+            for probe in [None, *range(1, args.probes + 1)]:
+                data, order, current = pair._two_blocks(effects, seed, probe)
+                final, out = drop_superseded(current, list(order), data, Criteria(),
+                                             max_nfev=1200)
+                print(f'| {effects} | {seed} | {probe or "-"} | {",".join(out) or "-"} | '
+                      f'{final.er_holdout_percent / data.floor_holdout_percent:.3f} |',
+                      flush=True)
     return 0
 
 

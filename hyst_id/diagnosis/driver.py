@@ -253,10 +253,12 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
         if winner is None:
             break
         mech = next(m for m in mechs if m.id == winner.mechanism)
-        findings.append(finding_from(winner, current, mech, loc, ctx, v_orig))
-        findings[-1].alternatives = alternatives_record(
+        alternatives = alternatives_record(
             tied, close_calls(comps, winner, tied, data, settings.criteria), data)
-        current = _reidentified(winner, findings[-1], data, ctx, spec, settings, floor_t, say)
+        winner.fit = _reidentified(winner, data, ctx, spec, settings, floor_t, say)
+        findings.append(finding_from(winner, current, mech, loc, ctx, v_orig))
+        findings[-1].alternatives = alternatives
+        current = winner.fit
         loc = locate(t, v_orig, y, current.prediction, sigma, n_train, ctx.period_s)
     notes = list(rec.notes) + range_note(v_orig, n_train, data.judged_rows.size)
     if len(findings) > 1:
@@ -269,6 +271,7 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
                          '(it stood in for what a later block explains)')
         if dropped:
             findings = [f for f in findings if f.mechanism not in dropped]
+            _refresh_values(findings, mechs, current, ctx, v_orig)
             loc = locate(t, v_orig, y, current.prediction, sigma, n_train, ctx.period_s)
     _final_corrections(findings, mechs, current, ctx, v_orig)
     final_loc = loc if current is not baseline else loc0
@@ -296,17 +299,33 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
                                          'judged_holdout': _judged(data, baseline, current)})
 
 
-def _reidentified(winner: Comparison, finding: Finding, data: Data, ctx: Context,
-                  spec: ChainSpec, settings: DiagnoseSettings, floor_t: float,
+def _reidentified(winner: Comparison, data: Data, ctx: Context, spec: ChainSpec,
+                  settings: DiagnoseSettings, floor_t: float,
                   say: Callable[[str], None]) -> FitResult:
-    """The accepted fit, or the whole chain re-identified with its blocks (refit module)."""
+    """The accepted fit, or the whole chain re-identified with its blocks (refit module).
+
+    The finding's values and errors are then those of the re-identified model;
+    the criteria that accepted the block were judged on its own fit.
+    """
     again = reidentify(winner.fit, data, ctx, spec, settings, floor_train_percent=floor_t)
     if again is not winner.fit:
         say(f're-identified the chain with {winner.mechanism}: training %e_r '
             f'{winner.fit.er_train_percent:.4g} -> {again.er_train_percent:.4g}')
-        finding.er_train_after_percent = again.er_train_percent
-        finding.er_holdout_after_percent = again.er_holdout_percent
     return again
+
+
+def _refresh_values(findings: list[Finding], mechs: list[Mechanism], final: FitResult,
+                    ctx: Context, command: np.ndarray) -> None:
+    """Each finding's values and words from ``final`` (after a block was withdrawn)."""
+    info = _info(final, ctx, command)
+    by_id = {m.id: m for m in mechs}
+    for f in findings:
+        m = by_id.get(f.mechanism)
+        if m is None or m.id not in final.model.slices:
+            continue
+        f.params = m.describe(final.model.theta(final.p, m.id), final.coef, info, ctx)
+        f.explanation = m.explain(f.params, f.where, ctx)
+        f.compensation['how'] = m.compensation_note(f.params, ctx)
 
 
 def _final_corrections(findings: list[Finding], mechs: list[Mechanism], final: FitResult,

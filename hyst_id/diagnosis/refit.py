@@ -27,11 +27,15 @@ time moves the command, a drift or gain in time is taken off the
 measurement, an additive output term is subtracted), identifies the chain
 afresh on what is left (identify's GAASS seeds, refined, and the data-built
 starts), puts the blocks back with their fitted values and polishes the
-whole model from each chain found. The best of these and the local fit is
-kept, so the result is never worse on the training part. When that is still
+whole model from each chain found. The best of these and the local fit on
+the training part is kept, so the result is never worse there. When that is still
 above :data:`REFIT_ABOVE` times the training floor, the same is done once
 more from the better fit (its blocks undone again) with identify's global
-phase (one differential-evolution run over the whole box).
+phase (one differential-evolution run over the whole box). A re-identified
+model that is worse than the local fit on the held-out samples the blocks
+are judged on is not kept: on the blind family a chain that fitted the
+training part better with the wrong block (a dead time for an end stop and a
+sensor lag, #22) extrapolated much worse.
 """
 
 from __future__ import annotations
@@ -92,16 +96,20 @@ def reidentify(fit: FitResult, data, ctx, spec: ChainSpec, settings, *,
     Returns
     -------
     FitResult
-        The better on the training part of ``fit`` and the re-identified model.
+        The re-identified model when it is better on the training part and not
+        worse on the judged held-out samples, else ``fit``.
     """
     model = fit.model
     if model is None or not model.mechanisms or model.swapped_by \
             or fit.er_train_percent <= REFIT_ABOVE * floor_train_percent:
         return fit
+    local = fit
     for global_phase in (False, True):
         fit = _reidentify_once(fit, data, ctx, spec, settings, global_phase)
         if fit.er_train_percent <= REFIT_ABOVE * floor_train_percent:
             break
+    if data.n_holdout and data.judged_er_percent(fit) > data.judged_er_percent(local):
+        return local    # better on the training part, worse where the blocks are judged
     return fit
 
 

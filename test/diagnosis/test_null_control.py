@@ -76,13 +76,14 @@ def test_a_block_that_only_carried_the_refit_is_withdrawn(drift, withdrawn):
     assert comp.accepted == (not withdrawn), comp.status
 
 
-def _two_blocks(effects: str, seed: int = 3):
+def _two_blocks(effects: str, seed: int = 3, probe: int | None = None):
     """A record with two effects and the model with two blocks fitted from the truth.
 
     ``'gain'``: a gain growing 0.08 %/s about a zero 8 travel units away, fitted with
     ``offset_drift`` (accepted first) and ``gain_drift``; a free gain pivot makes the
     ramp redundant. ``'delay+drift'``: a 0.3 s dead time and an offset ramp of 5 % of
-    the span, fitted with both blocks, each needed.
+    the span, fitted with both blocks, each needed. ``probe`` perturbs the measurement
+    by 1e-12 relative (another CPU's last bits).
     """
     t = np.arange(0.0, 120.0, 0.05)
     v = multisine(t, amplitude_ma=1.8)
@@ -97,6 +98,8 @@ def _two_blocks(effects: str, seed: int = 3):
         ids, thetas = ('dead_time', 'offset_drift'), {'dead_time': [0.3]}
     sigma = 0.004 * np.ptp(y)
     y = y + np.random.default_rng(seed).normal(0.0, sigma, t.size)
+    if probe is not None:
+        y = y * (1.0 + 1e-12 * np.random.default_rng([probe, seed]).standard_normal(y.size))
     data = Data(t_s=t, v=v, y=y, n_train=ctx.n_train, noise_std=sigma)
     model = ComposedModel('position', [MECHANISMS[i] for i in ids], ctx,
                           chain_spec('position').bounds)
