@@ -184,7 +184,8 @@ class ComposedModel:
             if m.stage == 'actuator':
                 x = m.actuator(th[m.id], x_chain, t_s, vv)
         if x is None:
-            x = self.position_spec.signal(x_chain[:self.spec.sensor_slice.start], t_s, vv)
+            x = self.position_spec.signal(x_chain[:self.spec.sensor_slice.start], t_s, vv,
+                                          validate=False)     # p is feasible
         seg = x[:max(2, n_span)]
         lo, hi = float(np.min(seg)), float(np.max(seg))
         if not hi > lo:
@@ -233,15 +234,15 @@ def solve_linear(a: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, float]:
     the residual is then computed directly, so coefficient round-off only
     enters the sum of squares at second order.
     """
-    scale = np.sqrt(np.einsum('ij,ij->j', a, a))
-    scale[scale == 0] = 1.0
-    an = a / scale
-    g = an.T @ an
-    g[np.diag_indices_from(g)] += 1e-12
+    g = a.T @ a
+    scale = np.sqrt(np.diagonal(g))
+    scale = np.where(scale > 0, scale, 1.0)
+    g = g / np.outer(scale, scale)
+    g.flat[::g.shape[0] + 1] += 1e-12
     try:
-        coef = np.linalg.solve(g, an.T @ y)
+        coef = np.linalg.solve(g, (a.T @ y) / scale)
     except np.linalg.LinAlgError:
-        coef, *_ = np.linalg.lstsq(an, y, rcond=1e-10)
+        coef, *_ = np.linalg.lstsq(a / scale, y, rcond=1e-10)
     coef = coef / scale
     r = y - a @ coef
     return coef, float(r @ r)

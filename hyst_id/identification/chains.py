@@ -386,12 +386,17 @@ class ChainSpec:
 
         return cost
 
-    def signal(self, params: np.ndarray, t_s: np.ndarray, command: np.ndarray) -> np.ndarray:
-        """Pre-calibration chain output ``s`` (sensor output in H's units)."""
-        p = self.check(params)
+    def signal(self, params: np.ndarray, t_s: np.ndarray, command: np.ndarray, *,
+               validate: bool = True) -> np.ndarray:
+        """Pre-calibration chain output ``s`` (sensor output in H's units).
+
+        ``validate=False`` skips :meth:`check`, for a caller that has already
+        found ``params`` feasible (:meth:`feasible` implies every rule of it).
+        """
+        p = self.check(params) if validate else np.ascontiguousarray(params, dtype=np.float64)
         v = np.ascontiguousarray(command, dtype=np.float64)
         dt, uniform = _intervals(t_s)
-        u = self.family.simulate(p[:self.n_h], self._h_command(v))
+        u = self.family.simulate(p[:self.n_h], self._h_command(v), validate=False)
         if self.falling:
             u = np.ascontiguousarray(u[1:])
         out = np.empty(v.shape[0])

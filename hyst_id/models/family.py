@@ -183,9 +183,15 @@ class HysteresisFamily:
         """Write H's output for every row of ``pop`` with ``ok`` true into ``out[i]``."""
         raise NotImplementedError
 
-    def simulate(self, params: np.ndarray, v: np.ndarray) -> np.ndarray:
-        """H's output for one (checked) parameter set and a command sequence."""
-        p = np.ascontiguousarray(self.check(params))[None, :]
+    def simulate(self, params: np.ndarray, v: np.ndarray, *, validate: bool = True
+                 ) -> np.ndarray:
+        """H's output for one parameter set and a command sequence.
+
+        The set is checked first unless ``validate`` is false (for a caller
+        that has already checked it, or found it feasible).
+        """
+        p = self.check(params) if validate else params
+        p = np.ascontiguousarray(p, dtype=np.float64)[None, :]
         out = np.empty((1, np.asarray(v).shape[0]))
         self.simulate_rows(p, np.ascontiguousarray(v, dtype=np.float64),
                            np.ones(1, dtype=np.bool_), out)
