@@ -143,3 +143,30 @@ def other_participant(name: str = 'io'):
     finally:
         node.destroy_node()
         other.try_shutdown()
+
+
+def _module_fixture_user(item: pytest.Item) -> bool:
+    """Whether a test uses a module-scoped fixture (computed once per module and worker)."""
+    info = getattr(item, '_fixtureinfo', None)
+    if info is None:
+        return False
+    return any(defs and defs[-1].scope == 'module'
+               for name, defs in info.name2fixturedefs.items() if name in item.fixturenames)
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_collection_modifyitems(config, items):
+    """Order and group the tests for two workers (``./run test``: ``--dist loadgroup``).
+
+    The tests of a module that share a module-scoped fixture go to one
+    worker together (an ``xdist_group``), so the fixture is computed once,
+    not once per worker. Modules holding ``slow`` tests run first, so that
+    the last tests handed out are short and the two workers end together.
+    Whole modules move, so a module's tests stay next to each other.
+    """
+    for item in items:
+        if _module_fixture_user(item) and item.get_closest_marker('xdist_group') is None:
+            item.add_marker(pytest.mark.xdist_group(name=item.nodeid.split('::')[0]))
+    slow_modules = {item.nodeid.split('::')[0] for item in items
+                    if item.get_closest_marker('slow') is not None}
+    items.sort(key=lambda item: item.nodeid.split('::')[0] not in slow_modules)
