@@ -156,17 +156,12 @@ def _module_fixture_user(item: pytest.Item) -> bool:
 
 @pytest.hookimpl(tryfirst=True)
 def pytest_collection_modifyitems(config, items):
-    """Order and group the tests for two workers (``./run test``: ``--dist loadgroup``).
+    """Group the tests for two workers (``./run test``: ``--dist loadgroup``).
 
     The tests of a module that share a module-scoped fixture go to one
     worker together (an ``xdist_group``), so the fixture is computed once,
-    not once per worker. Modules holding ``slow`` tests run first, so that
-    the last tests handed out are short and the two workers end together.
-    Whole modules move, so a module's tests stay next to each other.
+    not once per worker. The order is left as collected.
     """
     for item in items:
         if _module_fixture_user(item) and item.get_closest_marker('xdist_group') is None:
             item.add_marker(pytest.mark.xdist_group(name=item.nodeid.split('::')[0]))
-    slow_modules = {item.nodeid.split('::')[0] for item in items
-                    if item.get_closest_marker('slow') is not None}
-    items.sort(key=lambda item: item.nodeid.split('::')[0] not in slow_modules)
