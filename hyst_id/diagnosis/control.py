@@ -38,7 +38,7 @@ from hyst_id.diagnosis.model import ComposedModel
 from hyst_id.diagnosis.select import compare, Comparison, Criteria, Data, evaluate, FitResult
 from hyst_id.diagnosis.select import polish
 
-__all__ = ['drop_superseded', 'null_control', 'recheck']
+__all__ = ['drop_superseded', 'equivalent_chain', 'null_control', 'recheck']
 
 
 def null_control(candidate: Comparison, current: FitResult, data: Data, *,
@@ -49,6 +49,15 @@ def null_control(candidate: Comparison, current: FitResult, data: Data, *,
     hysteresis family) or the refit is not better than ``current`` on the
     training part.
     """
+    refit = _chain_refit(candidate, current, data, max_nfev=max_nfev)
+    if refit is None or not refit.sse_train < current.sse_train:
+        return None
+    return refit
+
+
+def _chain_refit(candidate: Comparison, current: FitResult, data: Data, *,
+                 max_nfev: int) -> FitResult | None:
+    """The current model polished from the chain of ``candidate``'s fit (None: not possible)."""
     prev, model = current.model, candidate.fit.model
     n = prev.n_chain
     if model.n_chain != n or model.spec.family.id != prev.spec.family.id:
@@ -57,10 +66,41 @@ def null_control(candidate: Comparison, current: FitResult, data: Data, *,
     p0 = prev.pack(candidate.fit.p[:n], thetas)
     if not prev.feasible(p0):
         return None
-    p, sse, nfev = polish(prev, data, p0, max_nfev=max_nfev)
-    if not sse < current.sse_train:
-        return None
+    p, _, nfev = polish(prev, data, p0, max_nfev=max_nfev)
     return evaluate(prev, data, p, nfev)
+
+
+def equivalent_chain(comparisons: list[Comparison], current: FitResult, data: Data,
+                     criteria: Criteria, *, max_nfev: int) -> FitResult | None:
+    """A chain that fits the training part as well as ``current`` and predicts held-out better.
+
+    When no block is accepted but the blocks' fits (each of which polishes
+    the chain again) predict the held-out part better than the current
+    model, the training part has not pinned the chain down: fits equally
+    good on it differ where the held-out part goes. The candidate with the
+    lowest judged held-out %e_r gives its chain; the current model is
+    polished from it without the block. The refit is returned when its
+    training BIC is not more than 2 above the current one (no more
+    parameters: equally good on the training part) and it passes the
+    held-out half of the acceptance test against ``current`` (improvement z,
+    gain and share; :func:`hyst_id.diagnosis.select.compare`). Otherwise None.
+    """
+    if current.model is None:
+        return None
+    usable = [c for c in comparisons if c.fit.model is not None]
+    if not usable:
+        return None
+    best = min(usable, key=lambda c: data.judged_er_percent(c.fit))
+    refit = _chain_refit(best, current, data, max_nfev=max_nfev)
+    if refit is None:
+        return None
+    n = data.n_train
+    if refit.bic(n) > current.bic(n) + 2.0:
+        return None
+    c = compare(current, refit, data, best.mechanism, criteria)
+    ok_hold = c.holdout_z > criteria.z_min and c.gain >= criteria.min_gain \
+        and c.share >= criteria.min_share
+    return refit if ok_hold else None
 
 
 def recheck(comparisons: list[Comparison], null: FitResult, data: Data,

@@ -48,7 +48,8 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from hyst_id.diagnosis.baseline import baseline_starts
-from hyst_id.diagnosis.control import drop_superseded, null_control, recheck
+from hyst_id.diagnosis.control import drop_superseded, equivalent_chain, null_control
+from hyst_id.diagnosis.control import recheck
 from hyst_id.diagnosis.empirical import empirical_block
 from hyst_id.diagnosis.locate import Localization, locate, noise_std
 from hyst_id.diagnosis.mechanisms import get_mechanisms
@@ -227,6 +228,7 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
     say(f'baseline: %e_r train {baseline.er_train_percent:.4g}, held-out '
         f'{baseline.er_holdout_percent:.4g} (noise floor {floor_h:.3g})')
     current, loc, findings, rounds = baseline, loc0, [], []
+    rechosen, chain_notes = False, []
     for round_no in range(settings.max_mechanisms):
         if not loc.structured and current.er_holdout_percent <= 1.5 * floor_h:
             break
@@ -250,6 +252,16 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
             loc = locate(t, v_orig, y, current.prediction, sigma, n_train, ctx.period_s)
             winner, tied = choose(comps, data, settings.criteria)
         rounds.append(round_record(round_no + 1, comps, winner, data))
+        if winner is None and not rechosen:
+            other = equivalent_chain(comps, current, data, settings.criteria,
+                                     max_nfev=2 * settings.fit_budget)
+            if other is not None:
+                say(f'round {round_no + 1}: no block, but an equally good chain predicts '
+                    'the held-out part better')
+                chain_notes.append(_rechosen_note(current, other, data))
+                current, rechosen = other, True
+                loc = locate(t, v_orig, y, current.prediction, sigma, n_train, ctx.period_s)
+                continue
         if winner is None:
             break
         mech = next(m for m in mechs if m.id == winner.mechanism)
@@ -260,7 +272,7 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
         findings[-1].alternatives = alternatives
         current = winner.fit
         loc = locate(t, v_orig, y, current.prediction, sigma, n_train, ctx.period_s)
-    notes = list(rec.notes) + range_note(v_orig, n_train, data.judged_rows.size)
+    notes = list(rec.notes) + range_note(v_orig, n_train, data.judged_rows.size) + chain_notes
     if len(findings) > 1:
         current, dropped = drop_superseded(current, [f.mechanism for f in findings], data,
                                            settings.criteria, max_nfev=2 * settings.fit_budget)
@@ -297,6 +309,17 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
                                          'hold': current.model.hold
                                          if current.model.dynamic else '',
                                          'judged_holdout': _judged(data, baseline, current)})
+
+
+def _rechosen_note(before: FitResult, after: FitResult, data: Data) -> str:
+    n = data.n_train
+    return (f'the chain was chosen again: no block was accepted, but a chain that fits the '
+            f'training part as well (%e_r {after.er_train_percent:.4g} against '
+            f'{before.er_train_percent:.4g}, BIC {after.bic(n) - before.bic(n):+.1f}) '
+            f'predicts the held-out part better (judged %e_r '
+            f'{data.judged_er_percent(after):.4g} against {data.judged_er_percent(before):.4g}); '
+            'the training part alone does not pin the chain down, and the held-out part '
+            'chose between equally good fits')
 
 
 def _reidentified(winner: Comparison, data: Data, ctx: Context, spec: ChainSpec,

@@ -81,16 +81,20 @@ def format_diagnosis(d: Any) -> str:
                          'command and at the noise floor on held-out data: this record shows no '
                          'physics that the model leaves out.')
         elif d.verdict == 'unknown':
-            ratio = d.baseline.er_holdout_percent / d.noise_floor_percent
+            ratio = d.final.er_holdout_percent / d.noise_floor_percent
             lines.append('verdict: unknown - the model misses something '
                          f'({ratio:.2f} x the noise floor on held-out data) and no mechanism '
                          'of the library explains it (table below); where it shows is above.')
         else:
-            ratio = d.baseline.er_holdout_percent / d.noise_floor_percent
+            ratio = d.final.er_holdout_percent / d.noise_floor_percent
             lines.append('verdict: none - no mechanism of the library improves the held-out '
                          'error significantly (table below). The remaining mismatch '
                          f'({ratio:.2f} x the noise floor on held-out data) is within what '
                          'the noise allows.')
+        if d.final is not d.baseline:
+            lines.append(f'final model: the same chain, chosen again (note below): %e_r train '
+                         f'{_fmt(d.final.er_train_percent)}, held-out '
+                         f'{_fmt(d.final.er_holdout_percent)}')
     if d.empirical is not None:
         lines.append(f'what is left: {d.empirical.summary()}.')
     for i, f in enumerate(d.findings):
