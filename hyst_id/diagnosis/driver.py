@@ -54,25 +54,23 @@ from hyst_id.diagnosis.empirical import empirical_block
 from hyst_id.diagnosis.locate import Localization, locate, noise_std
 from hyst_id.diagnosis.mechanisms import get_mechanisms
 from hyst_id.diagnosis.mechanisms.base import Context, Mechanism
-from hyst_id.diagnosis.model import ComposedModel, held
+from hyst_id.diagnosis.model import ComposedModel
 from hyst_id.diagnosis.refit import reidentify
 from hyst_id.diagnosis.result import DiagnoseSettings, Diagnosis, Finding
 from hyst_id.diagnosis.select import (
     alternatives_record,
     choose,
     close_calls,
-    compare,
     Comparison,
     Data,
     evaluate,
-    fit_model,
     FitResult,
     polish,
     round_record,
 )
+from hyst_id.diagnosis.trial import try_all
 from hyst_id.errors import ConfigError, RecordingError
 from hyst_id.identification.chains import chain_spec, ChainSpec, HOLDS
-from hyst_id.identification.domains import domains_from_data
 from hyst_id.io.recording import Recording, roundoff_probe, validate_recording
 from hyst_id.signals.noise import floor_percent
 from hyst_id.signals.reversals import period_s
@@ -236,13 +234,11 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
             break   # what structure is left is within the noise on held-out data
         done = set(current.ids)
         family = current.model.spec.family.id
-        comps = []
-        for m in mechs:
-            if m.id in done or (m.families is not None and family not in m.families) \
-                    or getattr(m, 'swap_family', '') == family:
-                continue
-            say(f'round {round_no + 1}: testing {m.id}')
-            comps.append(_try(m, current, data, ctx, settings, loc, chain_starts))
+        cands = [m for m in mechs if m.id not in done
+                 and (m.families is None or family in m.families)
+                 and getattr(m, 'swap_family', '') != family]
+        comps = try_all(cands, current, data, ctx, settings, loc, chain_starts,
+                        lambda text: say(f'round {round_no + 1}: {text}'))
         winner, tied = choose(comps, data, settings.criteria)
         null = None if winner is None else null_control(
             winner, current, data, max_nfev=2 * settings.fit_budget)
@@ -407,79 +403,3 @@ def _judged(data: Data, baseline: FitResult, final: FitResult) -> dict:
 def _chain_dict(channel: str, p: np.ndarray) -> dict:
     names = chain_spec(channel).names
     return {n: float(x) for n, x in zip(names, p[:len(names)])}
-
-
-def _try(m: Mechanism, current: FitResult, data: Data, ctx: Context,
-         settings: DiagnoseSettings, loc: Localization,
-         chain_starts: list[np.ndarray]) -> Comparison:
-    prev = current.model
-    thetas = {pm.id: prev.theta(current.p, pm.id) for pm in prev.mechanisms}
-    if getattr(m, 'swap_family', ''):
-        fit = _swap_family(m, current, data, ctx, settings, thetas)
-    else:
-        # the first filter on a static chain is fitted in both hold conventions
-        holds = (prev.hold,) if prev.dynamic or m.stage != 'sensor' else HOLDS
-        fit = None
-        for hold in holds:
-            model = ComposedModel(ctx.channel, list(prev.mechanisms) + [m], ctx,
-                                  prev.bounds[:prev.n_chain], family=prev.spec.family.id,
-                                  swapped_by=prev.swapped_by, hold=hold)
-            p_prev = model.pack(current.p[:prev.n_chain], thetas)
-            # the data-built starts are the baseline family's chains
-            got = fit_model(model, data, p_prev, m, budget=settings.fit_budget,
-                            chain_starts=[c for c in chain_starts if c.size == prev.n_chain])
-            if len(holds) > 1 and hold == 'after' and not _filter_beats_shift(got, m, data):
-                continue        # a one-sample delay in disguise: dead_time's business
-            if fit is None or got.sse_train < fit.sse_train:
-                fit = got
-    comp = compare(current, fit, data, m.id, settings.criteria)
-    comp.evidence, comp.where = m.evidence(loc)
-    model = fit.model
-    theta = model.theta(fit.p, m.id) if m.id in model.slices else np.zeros(0)
-    reason = m.implausible(theta, fit.coef, fit.span, data.noise_std, ctx)
-    if reason and comp.accepted:
-        comp.accepted, comp.status = False, f'rejected: {reason}'
-    return comp
-
-
-def _filter_beats_shift(fit: FitResult, m: Mechanism, data: Data) -> bool:
-    """Whether a filter block fitted in the ``after`` convention does more than its hold.
-
-    On a static chain the ``after`` convention is itself a one-sample delay, so a
-    nearly transparent filter in it is a delay (``dead_time``), not dynamics: the
-    block must change its (held) input by more than the hold's shift does. The
-    input is taken as the chain's travel (before position-stage blocks such as
-    an end stop, which change it little): a screening test, not the fit.
-    """
-    x = fit.travel_raw[:data.n_train]
-    shifted = held(x, 'after')
-    out = m.sensor(fit.model.theta(fit.p, m.id), data.t_s[:data.n_train], shifted)
-    return float(np.linalg.norm(out - shifted)) > float(np.linalg.norm(shifted - x))
-
-
-def _swap_family(m: Mechanism, current: FitResult, data: Data, ctx: Context,
-                 settings: DiagnoseSettings, thetas: dict) -> FitResult:
-    """The chain refitted with H from ``m.swap_family`` (the blocks that work with it kept).
-
-    H's family changes the chain's parameters, so there is nothing to
-    warm-start from: the new chain gets its own baseline fit (GAASS seeds and
-    data-built starts on the training part, each polished with the kept blocks).
-    """
-    prev, fam, n = current.model, m.swap_family, data.n_train
-    rec_train = Recording(data.t_s[:n], data.v[:n], data.y[:n], ctx.channel)
-    spec = domains_from_data(rec_train, family=fam)
-    keep = [pm for pm in prev.mechanisms if pm.families is None or fam in pm.families]
-    model = ComposedModel(ctx.channel, keep, ctx, spec.bounds, family=fam, swapped_by=m.id,
-                          hold=prev.hold)
-    x_fits, starts = baseline_starts(rec_train, spec, settings, thorough=False)
-    best = None
-    for x0 in x_fits + starts:
-        p0 = model.pack(x0, thetas)
-        if not model.feasible(p0):
-            continue
-        got = polish(model, data, p0, max_nfev=2 * settings.fit_budget)
-        if best is None or got[1] < best[1]:
-            best = got
-    if best is None:
-        return current
-    return evaluate(model, data, best[0], best[2])

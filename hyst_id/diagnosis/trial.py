@@ -1,0 +1,171 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""One round of the diagnosis: every candidate block fitted into the current model.
+
+:func:`try_all` fits each mechanism at its place in the chain (warm-started
+from the current model and the data-built chain starts; a mechanism that
+swaps the hysteresis family gets its own baseline fit) and judges it against
+the current model (:func:`hyst_id.diagnosis.select.compare`). The fits are
+independent of each other, so with ``settings.workers`` other than 1 they run
+in worker processes (:func:`hyst_id.identification.workers.map_in_processes`),
+the costliest first; each is computed exactly as in one process, and the
+comparisons come back in the order of ``mechs``, so the round's outcome does
+not depend on the number of workers.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+import os
+from typing import Callable
+
+import numpy as np
+
+from hyst_id.diagnosis.baseline import baseline_starts
+from hyst_id.diagnosis.locate import Localization
+from hyst_id.diagnosis.mechanisms.base import Context, Mechanism
+from hyst_id.diagnosis.model import ComposedModel, held
+from hyst_id.diagnosis.result import DiagnoseSettings
+from hyst_id.diagnosis.select import compare, Comparison, Data, evaluate, fit_model
+from hyst_id.diagnosis.select import FitResult, polish
+from hyst_id.identification.chains import HOLDS
+from hyst_id.identification.domains import domains_from_data
+from hyst_id.identification.workers import map_in_processes
+from hyst_id.io.recording import Recording
+
+__all__ = ['try_all', 'try_mechanism']
+
+#: Mechanisms whose fits cost the most, handed to workers first (the rest keep their order).
+COSTLY_FIRST = ('loop_shape', 'actuator_dynamics', 'creep', 'saturation')
+
+
+def try_all(mechs: list[Mechanism], current: FitResult, data: Data, ctx: Context,
+            settings: DiagnoseSettings, loc: Localization, chain_starts: list[np.ndarray],
+            say: Callable[[str], None] = lambda text: None) -> list[Comparison]:
+    """Fit and judge every mechanism of ``mechs`` against ``current``, in that order.
+
+    Parameters
+    ----------
+    mechs : list of Mechanism
+        Candidates of this round.
+    current : FitResult
+        The model they extend.
+    data, ctx, loc, chain_starts :
+        The record, its context, the located mismatch and the data-built chain starts.
+    settings : DiagnoseSettings
+        Fit budget, criteria and ``workers`` (0: one per core; 1: this process).
+    say : callable, optional
+        Progress, a line per mechanism.
+
+    Returns
+    -------
+    list of Comparison
+        One per mechanism, in the order of ``mechs``.
+    """
+    workers = min(settings.workers or (os.cpu_count() or 1), len(mechs))
+    if workers <= 1:
+        comps = []
+        for m in mechs:
+            say(f'testing {m.id}')
+            comps.append(try_mechanism(m, current, data, ctx, settings, loc, chain_starts))
+        return comps
+    say(f'testing {", ".join(m.id for m in mechs)} in {workers} processes')
+    order = sorted(range(len(mechs)), key=lambda i: (
+        COSTLY_FIRST.index(mechs[i].id) if mechs[i].id in COSTLY_FIRST else len(COSTLY_FIRST)))
+    one = replace(settings, workers=1)       # a worker does not start workers of its own
+    got = map_in_processes(try_mechanism, [(mechs[i], current, data, ctx, one, loc, chain_starts)
+                                           for i in order], workers,
+                           on_result=lambda c: say(f'{c.mechanism} fitted'))
+    comps: list[Comparison | None] = [None] * len(mechs)
+    for i, comp in zip(order, got):
+        comps[i] = comp
+    return comps
+
+
+def try_mechanism(m: Mechanism, current: FitResult, data: Data, ctx: Context,
+                  settings: DiagnoseSettings, loc: Localization,
+                  chain_starts: list[np.ndarray]) -> Comparison:
+    """Fit ``m`` into ``current`` and judge it (the criteria, its evidence, its plausibility)."""
+    prev = current.model
+    thetas = {pm.id: prev.theta(current.p, pm.id) for pm in prev.mechanisms}
+    if getattr(m, 'swap_family', ''):
+        fit = _swap_family(m, current, data, ctx, settings, thetas)
+    else:
+        # the first filter on a static chain is fitted in both hold conventions
+        holds = (prev.hold,) if prev.dynamic or m.stage != 'sensor' else HOLDS
+        fit = None
+        for hold in holds:
+            model = ComposedModel(ctx.channel, list(prev.mechanisms) + [m], ctx,
+                                  prev.bounds[:prev.n_chain], family=prev.spec.family.id,
+                                  swapped_by=prev.swapped_by, hold=hold)
+            p_prev = model.pack(current.p[:prev.n_chain], thetas)
+            # the data-built starts are the baseline family's chains
+            got = fit_model(model, data, p_prev, m, budget=settings.fit_budget,
+                            chain_starts=[c for c in chain_starts if c.size == prev.n_chain])
+            if len(holds) > 1 and hold == 'after' and not _filter_beats_shift(got, m, data):
+                continue        # a one-sample delay in disguise: dead_time's business
+            if fit is None or got.sse_train < fit.sse_train:
+                fit = got
+    comp = compare(current, fit, data, m.id, settings.criteria)
+    comp.evidence, comp.where = m.evidence(loc)
+    model = fit.model
+    theta = model.theta(fit.p, m.id) if m.id in model.slices else np.zeros(0)
+    reason = m.implausible(theta, fit.coef, fit.span, data.noise_std, ctx)
+    if reason and comp.accepted:
+        comp.accepted, comp.status = False, f'rejected: {reason}'
+    return comp
+
+
+def _filter_beats_shift(fit: FitResult, m: Mechanism, data: Data) -> bool:
+    """Whether a filter block fitted in the ``after`` convention does more than its hold.
+
+    On a static chain the ``after`` convention is itself a one-sample delay, so a
+    nearly transparent filter in it is a delay (``dead_time``), not dynamics: the
+    block must change its (held) input by more than the hold's shift does. The
+    input is taken as the chain's travel (before position-stage blocks such as
+    an end stop, which change it little): a screening test, not the fit.
+    """
+    x = fit.travel_raw[:data.n_train]
+    shifted = held(x, 'after')
+    out = m.sensor(fit.model.theta(fit.p, m.id), data.t_s[:data.n_train], shifted)
+    return float(np.linalg.norm(out - shifted)) > float(np.linalg.norm(shifted - x))
+
+
+def _swap_family(m: Mechanism, current: FitResult, data: Data, ctx: Context,
+                 settings: DiagnoseSettings, thetas: dict) -> FitResult:
+    """The chain refitted with H from ``m.swap_family`` (the blocks that work with it kept).
+
+    H's family changes the chain's parameters, so there is nothing to
+    warm-start from: the new chain gets its own baseline fit (GAASS seeds and
+    data-built starts on the training part, each polished with the kept blocks).
+    """
+    prev, fam, n = current.model, m.swap_family, data.n_train
+    rec_train = Recording(data.t_s[:n], data.v[:n], data.y[:n], ctx.channel)
+    spec = domains_from_data(rec_train, family=fam)
+    keep = [pm for pm in prev.mechanisms if pm.families is None or fam in pm.families]
+    model = ComposedModel(ctx.channel, keep, ctx, spec.bounds, family=fam, swapped_by=m.id,
+                          hold=prev.hold)
+    x_fits, starts = baseline_starts(rec_train, spec, settings, thorough=False)
+    best = None
+    for x0 in x_fits + starts:
+        p0 = model.pack(x0, thetas)
+        if not model.feasible(p0):
+            continue
+        got = polish(model, data, p0, max_nfev=2 * settings.fit_budget)
+        if best is None or got[1] < best[1]:
+            best = got
+    if best is None:
+        return current
+    return evaluate(model, data, best[0], best[2])

@@ -1,0 +1,70 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""A round's candidate fits are the same in worker processes as in one process.
+
+:func:`hyst_id.diagnosis.trial.try_all` hands the mechanisms to workers (the
+costliest first) when ``settings.workers`` is not 1; each fit is computed as
+in one process and the comparisons come back in the order given, so the
+round, and with it the diagnosis, does not depend on the number of workers.
+Exact equality is asserted: the same arithmetic runs in either case.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+from reference_sim import simulate as reference_simulate
+
+from hyst_id.diagnosis.locate import locate
+from hyst_id.diagnosis.mechanisms import Context, get_mechanisms
+from hyst_id.diagnosis.model import ComposedModel
+from hyst_id.diagnosis.result import DiagnoseSettings
+from hyst_id.diagnosis.select import Data, evaluate
+from hyst_id.diagnosis.trial import try_all
+from hyst_id.identification.chains import chain_spec
+from hyst_id.signals.excitation import multisine
+
+NAMES = ('m_l', 'm_r', 'm_t', 'm_b', 'c_l', 'c_r', 'c_t', 'c_b', 'm_bl', 'c_bl', 'c_br')
+TRUTH = np.array([1.01, 1.05, 0.10, 0.15, -0.25, 0.50, 14.0, 7.0, 1.0, -0.15, 0.15])
+
+
+def test_a_round_in_two_processes_equals_the_round_in_one():
+    t = np.arange(0.0, 60.0, 0.05)
+    v = multisine(t, amplitude_ma=1.8)
+    x = reference_simulate('position', dict(zip(NAMES, TRUTH)), t, np.interp(t - 0.2, t, v))
+    sigma = 0.004 * np.ptp(x)
+    y = x + np.random.default_rng(4).normal(0.0, sigma, t.size)
+    n = int(0.7 * t.size)
+    ctx = Context('position', t, n)
+    data = Data(t_s=t, v=v, y=y, n_train=n, noise_std=sigma)
+    current = evaluate(ComposedModel('position', [], ctx, chain_spec('position').bounds),
+                       data, TRUTH)
+    loc = locate(t, v, y, current.prediction, sigma, n, None)
+    mechs = get_mechanisms(('offset_drift', 'dead_time', 'sensor_lag', 'saturation'),
+                           channel='position')
+    settings = DiagnoseSettings(fit_budget=300)
+    lines: list[str] = []
+    rounds = [try_all(mechs, current, data, ctx, replace(settings, workers=w), loc, [],
+                      lines.append) for w in (1, 2)]
+    assert [c.mechanism for c in rounds[1]] == [m.id for m in mechs]
+    for one, two in zip(*rounds):
+        assert (one.mechanism, one.status, one.accepted) == (two.mechanism, two.status,
+                                                             two.accepted)
+        np.testing.assert_array_equal(one.fit.p, two.fit.p)
+        assert one.fit.sse_train == two.fit.sse_train
+        assert one.holdout_z == two.holdout_z
+    assert any('in 2 processes' in line for line in lines)
+    assert next(c for c in rounds[1] if c.mechanism == 'dead_time').accepted
