@@ -65,10 +65,9 @@ from hyst_id.diagnosis.select import (
     Data,
     evaluate,
     FitResult,
-    polish,
     round_record,
 )
-from hyst_id.diagnosis.trial import try_all
+from hyst_id.diagnosis.trial import polish_all, try_all
 from hyst_id.errors import ConfigError, RecordingError
 from hyst_id.identification.chains import chain_spec, ChainSpec, HOLDS
 from hyst_id.io.recording import Recording, roundoff_probe, validate_recording
@@ -212,10 +211,11 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
     # a channel with a sensor has dynamics from the start: its hold convention is chosen
     # here, on the training error (a position chain is static until a filter block joins)
     holds = HOLDS if rec.channel != 'position' else HOLDS[:1]
-    polished = sorted((polish(model, data, x0, max_nfev=2 * settings.fit_budget) + (x0, model)
-                       for model in [ComposedModel(rec.channel, [], ctx, spec.bounds, hold=h)
-                                     for h in holds]
-                       for x0 in x_fits + starts), key=lambda z: z[1])
+    pairs = [(model, x0) for model in [ComposedModel(rec.channel, [], ctx, spec.bounds, hold=h)
+                                       for h in holds] for x0 in x_fits + starts]
+    polished = sorted((got + (x0, model) for got, (model, x0) in zip(
+        polish_all(pairs, data, 2 * settings.fit_budget, settings.workers), pairs)),
+        key=lambda z: z[1])
     baseline = evaluate(polished[0][4], data, polished[0][0], polished[0][2])
     # the neutral data-built starts whose basins fitted best seed the mechanism fits
     chain_starts = [z[3] for z in polished if any(z[3] is s for s in starts)

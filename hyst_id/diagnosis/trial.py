@@ -45,7 +45,7 @@ from hyst_id.identification.domains import domains_from_data
 from hyst_id.identification.workers import map_in_processes
 from hyst_id.io.recording import Recording
 
-__all__ = ['try_all', 'try_mechanism']
+__all__ = ['polish_all', 'try_all', 'try_mechanism']
 
 #: Mechanisms whose fits cost the most, handed to workers first (the rest keep their order).
 COSTLY_FIRST = ('loop_shape', 'actuator_dynamics', 'creep', 'saturation')
@@ -92,6 +92,24 @@ def try_all(mechs: list[Mechanism], current: FitResult, data: Data, ctx: Context
     for i, comp in zip(order, got):
         comps[i] = comp
     return comps
+
+
+def polish_all(pairs: list[tuple[ComposedModel, np.ndarray]], data: Data, max_nfev: int,
+               workers: int) -> list[tuple[np.ndarray, float, int]]:
+    """:func:`hyst_id.diagnosis.select.polish` of each ``(model, start)``, in that order.
+
+    ``workers`` as in :class:`DiagnoseSettings` (0: one per core); each polish is
+    computed as in one process.
+    """
+    n = min(workers or (os.cpu_count() or 1), len(pairs))
+    if n <= 1:
+        return [polish(model, data, x0, max_nfev=max_nfev) for model, x0 in pairs]
+    return map_in_processes(_polish_one, [(model, data, x0, max_nfev) for model, x0 in pairs], n)
+
+
+def _polish_one(model: ComposedModel, data: Data, x0: np.ndarray,
+                max_nfev: int) -> tuple[np.ndarray, float, int]:
+    return polish(model, data, x0, max_nfev=max_nfev)
 
 
 def try_mechanism(m: Mechanism, current: FitResult, data: Data, ctx: Context,

@@ -33,7 +33,7 @@ from hyst_id.diagnosis.mechanisms import Context, get_mechanisms
 from hyst_id.diagnosis.model import ComposedModel
 from hyst_id.diagnosis.result import DiagnoseSettings
 from hyst_id.diagnosis.select import Data, evaluate
-from hyst_id.diagnosis.trial import try_all
+from hyst_id.diagnosis.trial import polish_all, try_all
 from hyst_id.identification.chains import chain_spec
 from hyst_id.signals.excitation import multisine
 
@@ -68,3 +68,20 @@ def test_a_round_in_two_processes_equals_the_round_in_one():
         assert one.holdout_z == two.holdout_z
     assert any('in 2 processes' in line for line in lines)
     assert next(c for c in rounds[1] if c.mechanism == 'dead_time').accepted
+
+
+def test_the_baseline_polishes_in_two_processes_equal_those_in_one():
+    t = np.arange(0.0, 40.0, 0.05)
+    v = multisine(t, amplitude_ma=1.8)
+    x = reference_simulate('position', dict(zip(NAMES, TRUTH)), t, v)
+    sigma = 0.004 * np.ptp(x)
+    y = x + np.random.default_rng(5).normal(0.0, sigma, t.size)
+    ctx = Context('position', t, int(0.7 * t.size))
+    data = Data(t_s=t, v=v, y=y, n_train=ctx.n_train, noise_std=sigma)
+    model = ComposedModel('position', [], ctx, chain_spec('position').bounds)
+    starts = [TRUTH * f for f in (0.97, 1.0, 1.03)]
+    pairs = [(model, x0) for x0 in starts]
+    one, two = (polish_all(pairs, data, 200, w) for w in (1, 2))
+    for a, b in zip(one, two):
+        np.testing.assert_array_equal(a[0], b[0])
+        assert a[1:] == b[1:]
