@@ -23,10 +23,14 @@
    unless a chain spec is given;
 2. locates the mismatch in the residual (:mod:`hyst_id.diagnosis.locate`);
 3. inserts every mechanism of the library (:mod:`hyst_id.diagnosis.mechanisms`)
-   at its place in the chain, refits locally from the baseline and keeps the
-   best one the data support (:mod:`hyst_id.diagnosis.select`) and that more
-   than the chain's refit alone explains (:mod:`hyst_id.diagnosis.control`);
-   repeats once more if the residual still has structure;
+   at its place in the chain, refits locally from the baseline (in worker
+   processes when ``settings.workers`` is not 1: :mod:`hyst_id.diagnosis.trial`)
+   and keeps the best one the data support (:mod:`hyst_id.diagnosis.select`)
+   and that more than the chain's refit alone explains
+   (:mod:`hyst_id.diagnosis.control`); when none is accepted but a chain as
+   good on the training part predicts the held-out part better, that chain is
+   taken and the round runs again; repeats once more if the residual still
+   has structure;
 4. returns a :class:`Diagnosis` whose :meth:`~Diagnosis.to_dict` is the
    ``--json`` document and whose :meth:`~Diagnosis.report` is the text report.
 
