@@ -62,7 +62,7 @@ from hyst_id.identification.chains import er_percent
 
 __all__ = ['Criteria', 'Data', 'FitResult', 'Comparison', 'evaluate', 'fit_model', 'polish',
            'compare', 'choose', 'close_calls', 'alternatives_record', 'explained_share',
-           'improvement_z', 'round_record']
+           'improvement_z', 'passes_holdout', 'round_record']
 
 
 @dataclass(frozen=True)
@@ -374,12 +374,19 @@ def compare(current: FitResult, candidate: FitResult, data: Data, mechanism: str
     gain = 1.0 - er_cand / er_cur if er_cur > 0 else 0.0
     share = explained_share(er_cur, er_cand, data.floor_holdout_percent)
     ok_train = d_bic < -criteria.bic_drop
-    ok_hold = z > criteria.z_min and gain >= criteria.min_gain and share >= criteria.min_share
-    status = 'accepted' if ok_train and ok_hold else (
-        'training only' if ok_train else 'rejected')
-    return Comparison(mechanism=mechanism, fit=candidate, delta_bic=float(d_bic),
-                      holdout_z=float(z), gain=float(gain), accepted=ok_train and ok_hold,
-                      status=status, share=float(share))
+    comp = Comparison(mechanism=mechanism, fit=candidate, delta_bic=float(d_bic),
+                      holdout_z=float(z), gain=float(gain), accepted=False, status='',
+                      share=float(share))
+    ok_hold = passes_holdout(comp, criteria)
+    comp.accepted = ok_train and ok_hold
+    comp.status = 'accepted' if comp.accepted else ('training only' if ok_train else 'rejected')
+    return comp
+
+
+def passes_holdout(comp: Comparison, criteria: Criteria) -> bool:
+    """The held-out half of :func:`compare`'s test: improvement z, gain and share."""
+    return (comp.holdout_z > criteria.z_min and comp.gain >= criteria.min_gain
+            and comp.share >= criteria.min_share)
 
 
 def choose(comparisons: list[Comparison], data: Data, criteria: Criteria

@@ -74,7 +74,7 @@ def try_all(mechs: list[Mechanism], current: FitResult, data: Data, ctx: Context
     list of Comparison
         One per mechanism, in the order of ``mechs``.
     """
-    workers = min(settings.workers or (os.cpu_count() or 1), len(mechs))
+    workers = _processes(settings.workers, len(mechs))
     if workers <= 1:
         comps = []
         for m in mechs:
@@ -101,10 +101,15 @@ def polish_all(pairs: list[tuple[ComposedModel, np.ndarray]], data: Data, max_nf
     ``workers`` as in :class:`DiagnoseSettings` (0: one per core); each polish is
     computed as in one process.
     """
-    n = min(workers or (os.cpu_count() or 1), len(pairs))
+    n = _processes(workers, len(pairs))
     if n <= 1:
         return [polish(model, data, x0, max_nfev=max_nfev) for model, x0 in pairs]
     return map_in_processes(_polish_one, [(model, data, x0, max_nfev) for model, x0 in pairs], n)
+
+
+def _processes(workers: int, n_tasks: int) -> int:
+    """Processes for ``n_tasks`` tasks: ``workers`` (0: one per core), at most one per task."""
+    return min(workers or (os.cpu_count() or 1), n_tasks)
 
 
 def _polish_one(model: ComposedModel, data: Data, x0: np.ndarray,
