@@ -22,9 +22,13 @@ that the test's bounds sit outside what the computation gives elsewhere:
 for a clean recording with an under-converged baseline, whether the block is
 accepted against the baseline, the refit's training SSE over the baseline's,
 its held-out %e_r over the floor and whether the block is withdrawn; for a
-recording with a real offset drift, whether the block survives.
+recording with a real offset drift, whether the block survives; and for the
+equivalent-chain rule (a current model as good on training, its held-out
+prediction moved by 0, 0.2 and 3 noise std), the gain the shift costs, how
+often the refit is chosen, its held-out %e_r over the floor and its training BIC
+against the current one.
 
-Run from the repository root (about a minute)::
+Run from the repository root (a few minutes)::
 
     python bench/null_control_spread.py [--seeds 8] [--probes 3]
 """
@@ -82,6 +86,20 @@ def main() -> int:
               f'{int(acc.sum())}/{len(rows)}; withdrawn {int(gone.sum())}/{len(rows)}; '
               f'refit SSE / baseline SSE {np.nanmin(ratio):.3f}-{np.nanmax(ratio):.3f}; '
               f'refit held-out / floor {np.nanmin(er):.2f}-{np.nanmax(er):.2f}')
+    for shift in (0.0, 0.2, 3.0):
+        rows = [case.equivalent_case(shift, s, probe) for probe in
+                [None, *range(1, args.probes + 1)] for s in range(args.seeds)]
+        chosen = [(d, cur, o) for d, cur, _, o in rows if o is not None]
+        gains = np.array([g for _, _, g, _ in rows])
+        line = (f'equivalent chain, held-out off by {shift:g} std: {len(rows)} runs; shift '
+                f'costs {100 * gains.min():.1f}-{100 * gains.max():.1f} % held-out gain; '
+                f'chosen {len(chosen)}/{len(rows)}')
+        if chosen:
+            er = [o.er_holdout_percent / d.floor_holdout_percent for d, _, o in chosen]
+            dbic = [o.bic(d.n_train) - cur.bic(d.n_train) for d, cur, o in chosen]
+            line += (f'; refit held-out / floor {min(er):.2f}-{max(er):.2f}, training BIC '
+                     f'{min(dbic):+.1f} to {max(dbic):+.1f}')
+        print(line, flush=True)
     return 0
 
 

@@ -129,23 +129,44 @@ def _held_out_off(fit, data, shift):
     return replace(fit, prediction=pred, residual=res, sse_holdout=float(ho @ ho))
 
 
+def equivalent_case(shift_sigmas: float, seed: int = 3, probe: int | None = None):
+    """The rule on a clean record against a chain as good on training, off on held-out.
+
+    The current model is the truth's polish with its held-out prediction moved by
+    ``shift_sigmas`` noise std; an ``offset_drift`` fit from the truth is the only
+    candidate. ``probe`` perturbs the measurement by 1e-12 relative (another CPU's
+    last bits). Returns the data, the current model, the gain the shift costs on the
+    judged held-out samples, and what :func:`equivalent_chain` returns.
+    """
+    data, base, m, model = make_case(0.0, seed)
+    if probe is not None:
+        data.y = data.y * (1.0 + 1e-12 * np.random.default_rng([probe, seed]).standard_normal(
+            data.y.size))
+    truth = evaluate(base, data, polish(base, data, TRUTH, max_nfev=1200)[0])
+    current = _held_out_off(truth, data, shift_sigmas * data.noise_std)
+    fit = fit_model(model, data, model.pack(TRUTH, {}), m, budget=600)
+    comp = compare(current, fit, data, m.id, Criteria())
+    gain = 1.0 - data.judged_er_percent(truth) / data.judged_er_percent(current)
+    return data, current, gain, equivalent_chain([comp], current, data, Criteria(),
+                                                 max_nfev=1200)
+
+
 @pytest.mark.parametrize('shift_sigmas, chosen', [(0.0, False), (0.2, False), (3.0, True)])
 def test_an_equally_good_chain_that_predicts_better_is_chosen(shift_sigmas, chosen):
     """With no block accepted, an equally good chain that predicts held-out better is chosen.
 
     The chain the block's fit found replaces one that fits training as well and misses
     held-out by ``shift_sigmas`` noise std (3: chosen; 0 and 0.2, below the acceptance
-    test's 5 % gain: kept).
+    test's 5 % gain: kept). Spread from ``bench/null_control_spread.py`` (8 noise seeds x
+    4 round-off conditions): a shift of 0.2 std costs 0.4-3.1 % held-out gain (criterion
+    5 %), never chosen; 3 std chosen 32/32 with the refit at 0.98-1.04 x the floor (bound
+    1.2) and its training BIC -4.7 to +5.1 against the current one (bound +10, the
+    criteria's ``bic_drop``; with +2 the test's own seed failed under round-off probe 2).
     """
-    data, base, m, model = make_case(0.0)
-    truth = evaluate(base, data, polish(base, data, TRUTH, max_nfev=1200)[0])
-    current = _held_out_off(truth, data, shift_sigmas * data.noise_std)
-    fit = fit_model(model, data, model.pack(TRUTH, {}), m, budget=600)
-    comp = compare(current, fit, data, m.id, Criteria())
-    other = equivalent_chain([comp], current, data, Criteria(), max_nfev=1200)
+    data, current, _, other = equivalent_case(shift_sigmas)
     assert (other is not None) == chosen
     if chosen:
         n = data.n_train
         assert other.ids == current.ids
-        assert other.bic(n) <= current.bic(n) + 2.0
+        assert other.bic(n) <= current.bic(n) + Criteria().bic_drop
         assert other.er_holdout_percent < 1.2 * data.floor_holdout_percent
