@@ -42,6 +42,8 @@ Run from the repository root (about 55 minutes for 150 recordings on 2 cores)::
         # one at a time, each diagnosis in two processes: the time per recording on 2 cores
     python bench/blind_family.py --indices 38 42 64      # some recordings again, no write
     python bench/blind_family.py --from-json     # the tables again, from the last run
+    git show REV:docs/diagnosis_blind.json > old.json
+    python bench/blind_family.py --compare old.json  # what moved since REV's run
 """
 
 from __future__ import annotations
@@ -215,6 +217,22 @@ def summary(rows: list[dict], how: str = 'one worker each') -> str:
     return '\n'.join(lines)
 
 
+def moved(old: list[dict], new: list[dict]) -> str:
+    """The recordings whose findings or final held-out / floor moved, a line each."""
+    before = {r['index']: r for r in old}
+    lines = []
+    for r in new:
+        o = before.get(r['index'])
+        if o is None:
+            continue
+        was, now = '+'.join(o['found']) or o['verdict'], '+'.join(r['found']) or r['verdict']
+        if was != now or abs(o['final'] - r['final']) > 0.05:
+            lines.append(f'#{r["index"]} {"+".join(r["effects"]) or "clean"} (cost '
+                         f'{r["cost"]:.1f} x): {was} {o["final"]:.2f} x -> {now} '
+                         f'{r["final"]:.2f} x')
+    return '\n'.join(lines) or 'nothing moved'
+
+
 def main() -> int:
     """Run the family, print and write the tables."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -226,9 +244,16 @@ def main() -> int:
                          '(the per-recording time on K cores; --workers is then unused)')
     ap.add_argument('--indices', type=int, nargs='+', metavar='I',
                     help='only these recordings (implies --no-write)')
+    ap.add_argument('--compare', metavar='OLD_JSON',
+                    help='only list the recordings whose findings or final (by more than '
+                         '0.05 x) differ between OLD_JSON and docs/diagnosis_blind.json')
     ap.add_argument('--from-json', action='store_true',
                     help='only reprint the tables from docs/diagnosis_blind.json')
     args = ap.parse_args()
+    if args.compare:
+        print(moved(json.loads(Path(args.compare).read_text()),
+                    json.loads((ROOT / 'docs' / 'diagnosis_blind.json').read_text())))
+        return 0
     if args.from_json:
         print(summary(json.loads((ROOT / 'docs' / 'diagnosis_blind.json').read_text())))
         return 0
