@@ -70,8 +70,8 @@ def add_settings_arguments(parser: argparse.ArgumentParser) -> None:
                    'sensor hold, then longer ones) while the best fit stays above 1.1 x the '
                    'noise floor (default 200000; 0 = no global phase: faster, but a trapped '
                    'fit stays trapped)')
-    g.add_argument('--global-runs', type=int, default=6, metavar='N',
-                   help='most runs of the global phase (default 6; 0 = none)')
+    g.add_argument('--global-runs', type=int, default=14, metavar='N',
+                   help='most runs of the global phase (default 14; 0 = none)')
     g.add_argument('--search-samples', type=int, default=20000, metavar='N',
                    help='on a longer record GAASS searches on every k-th sample plus every '
                    'command reversal; refinement and results use all samples '

@@ -39,7 +39,7 @@ def make_settings(*, seeds: int = 10, seed_offset: int = 0, pop_size: int = 10,
                   generations: int = 500, c: float = 0.007, xi: float = 0.02,
                   workers: int = 0, refine: bool = True, restarts: int = 4,
                   er_bound_percent: float | None = None,
-                  global_evals: int = 200000, global_runs: int = 6,
+                  global_evals: int = 200000, global_runs: int = 14,
                   search_samples: int = 20000) -> IdentifySettings:
     """GAASS and refinement settings (the paper's by default), checked.
 

@@ -56,10 +56,12 @@ ROUND = 2
 _LONG_RUN = 3
 
 #: The longer runs only while the best fit is within this multiple of the floor: further
-#: off, what is missing is more likely physics the chain lacks (a real recording) than a
-#: trap; on the reference family every miss they fixed was at 1.17-1.48 x before them
-#: (#84, #40, #47, #2: docs/data/generalisation_*global_runs*.jsonl).
-LONG_RUNS_WITHIN = 1.5
+#: off, what is missing is more likely physics the chain lacks than a trap (the shared real
+#: recordings end at 44-108 x: bench/real_recordings.py). On the
+#: reference family the traps they got out of were at 1.17-3.65 x before them (#84, #40,
+#: #47, #2, #170 and #44 at 3.65 x, which 1.5 had left out:
+#: docs/data/generalisation_misses_long_runs_4x.jsonl).
+LONG_RUNS_WITHIN = 4.0
 
 
 def global_phase(spec: ChainSpec, rec: Recording, settings: IdentifySettings,

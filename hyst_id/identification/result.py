@@ -78,14 +78,16 @@ class IdentifySettings:
         over the whole box, each refined, join the runs (seeds ``-1``,
         ``-2``, ...) when they do better: one per initial state and sensor
         hold convention with this many evaluations, then, while the fit is
-        within 1.5 x the floor, runs with three times as many under the best
-        fit's conventions, in rounds of two until the fit reaches
+        within 4 x the floor (``LONG_RUNS_WITHIN``), runs with three times
+        as many under the best fit's conventions, in rounds of two until the
+        fit reaches
         ``global_factor`` or ``global_runs`` are spent
         (:mod:`hyst_id.identification.global_phase`). 0: off.
     global_factor : float
         The floor multiple above which the global phase runs.
     global_runs : int
-        Most runs of the global phase (0: off).
+        Most runs of the global phase (0: off); 14: the sweep of
+        conventions and up to ten longer runs.
     search_samples : int
         With refinement on, on a record longer than this the GAASS runs, the
         polishes of each run's best chromosomes and of the data-built starts
@@ -114,7 +116,7 @@ class IdentifySettings:
     conventions: str = 'auto'
     global_evals: int = 200000
     global_factor: float = 1.1
-    global_runs: int = 6
+    global_runs: int = 14
     search_samples: int = 20000
 
 

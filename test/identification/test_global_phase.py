@@ -67,7 +67,7 @@ def test_every_convention_before_longer_runs_under_the_best(calls):
     spec = chain_spec('pressure')
     scores += [9.0, 8.0, 1.5, 7.0, 1.4, 1.3]          # never below 1.1 x a floor of 1
     best = _run(replace(spec, initial='rising', hold='before'), 10.0)
-    settings = IdentifySettings(global_evals=1000)
+    settings = IdentifySettings(global_evals=1000, global_runs=6)
     seen = []
     improved = gp.global_phases(spec, _others(spec), None, settings, best, 1.0,
                                 on_run=lambda run: seen.append(run.seed))
@@ -82,12 +82,24 @@ def test_every_convention_before_longer_runs_under_the_best(calls):
 
 
 def test_no_longer_runs_far_from_the_floor(calls):
-    """Beyond 1.5 x the floor the misfit is taken for missing physics, not a trap."""
+    """Beyond LONG_RUNS_WITHIN x the floor the misfit is taken for missing physics, not a trap."""
     made, scores = calls
     spec = chain_spec('flow')
-    scores += [9.0, 8.0, 1.6, 7.0]
+    scores += [9.0, 8.0, 1.01 * gp.LONG_RUNS_WITHIN, 7.0]
     gp.global_phases(spec, _others(spec), None, IdentifySettings(), _run(spec, 10.0), 1.0)
     assert len(made) == 4                               # the conventions only
+
+
+def test_by_default_ten_longer_runs_within_four_times_the_floor(calls):
+    """A trap at 3.5 x gets the sweep and then ten longer runs (#44 of the family: 3.65 x)."""
+    made, scores = calls
+    spec = chain_spec('flow')
+    scores += [9.0, 8.0, 3.5, 7.0] + [3.4 - 0.1 * k for k in range(10)]
+    settings = IdentifySettings()
+    improved = gp.global_phases(spec, _others(spec), None, settings, _run(spec, 10.0), 1.0)
+    assert len(made) == settings.global_runs == 14
+    assert [m[3] for m in made] == [settings.global_evals] * 4 + [3 * settings.global_evals] * 10
+    assert improved[-1].fun == pytest.approx(2.5)
 
 
 def test_stops_after_the_round_that_reaches_the_floor(calls):
@@ -149,7 +161,7 @@ def test_identify_sweeps_every_convention_of_a_sensor_channel():
         seeds=(0,), maxiter=20, restarts=0, workers=1, global_evals=3000, global_runs=6),
         progress=lambda done, total, run: seen.append(run))
     glob = [r for r in seen if r.seed < 0]
-    assert ident.er_percent > 1.5 * ident.noise_floor_percent     # no longer runs
+    assert ident.er_percent > gp.LONG_RUNS_WITHIN * ident.noise_floor_percent  # no longer
     assert [r.seed for r in glob] == [-1, -2, -3, -4]
     assert {(r.initial, r.hold) for r in glob} == {(i, h) for i in ('rising', 'falling')
                                                    for h in ('before', 'after')}
@@ -182,7 +194,7 @@ def test_identify_reports_each_global_run_after_its_seeds():
     ident = identify(rec, settings=IdentifySettings(
         seeds=(0,), maxiter=20, restarts=0, workers=1, global_evals=3000, global_runs=4),
         progress=progress)
-    assert ident.er_percent > 1.5 * ident.noise_floor_percent     # no longer runs
+    assert ident.er_percent > gp.LONG_RUNS_WITHIN * ident.noise_floor_percent  # no longer
     # position: two initial states, no sensor hold; the bar's total counts the most runs
     assert calls == [(1, 1, 0), (2, 5, -1), (3, 5, -2)]
     # every evaluation counts, also a global run's that did not improve (not in runs)
