@@ -72,6 +72,9 @@ def add_settings_arguments(parser: argparse.ArgumentParser) -> None:
                    'fit stays trapped)')
     g.add_argument('--global-runs', type=int, default=14, metavar='N',
                    help='most runs of the global phase (default 14; 0 = none)')
+    g.add_argument('--hops', type=int, default=100, metavar='N',
+                   help='when the best seed ends between 1.1 and 4 x the noise floor, the '
+                   'most jumps of basin hopping from it, each polished (default 100; 0 = none)')
     g.add_argument('--search-samples', type=int, default=20000, metavar='N',
                    help='on a longer record GAASS searches on every k-th sample plus every '
                    'command reversal; refinement and results use all samples '
@@ -104,7 +107,7 @@ def make_settings(args: argparse.Namespace) -> IdentifySettings:
         seeds=args.seeds, seed_offset=args.seed_offset, pop_size=args.pop_size,
         generations=args.generations, c=args.c, xi=args.xi, workers=args.workers,
         refine=not args.gaass_only, restarts=args.restarts, er_bound_percent=args.er_bound,
-        global_evals=args.global_evals, global_runs=args.global_runs,
+        global_evals=args.global_evals, global_runs=args.global_runs, hops=args.hops,
         search_samples=args.search_samples)
 
 

@@ -39,7 +39,7 @@ def make_settings(*, seeds: int = 10, seed_offset: int = 0, pop_size: int = 10,
                   generations: int = 500, c: float = 0.007, xi: float = 0.02,
                   workers: int = 0, refine: bool = True, restarts: int = 4,
                   er_bound_percent: float | None = None,
-                  global_evals: int = 200000, global_runs: int = 14,
+                  global_evals: int = 200000, global_runs: int = 14, hops: int = 100,
                   search_samples: int = 20000) -> IdentifySettings:
     """GAASS and refinement settings (the paper's by default), checked.
 
@@ -47,18 +47,19 @@ def make_settings(*, seeds: int = 10, seed_offset: int = 0, pop_size: int = 10,
     ------
     ConfigError
         Fewer than one seed or generation, a population below two, negative restarts,
-        global evaluations or runs, or search samples.
+        global evaluations, runs or hops, or search samples.
     """
     if seeds < 1 or pop_size < 2 or generations < 1 or restarts < 0 or global_evals < 0 \
-            or global_runs < 0 or search_samples < 0:
+            or global_runs < 0 or hops < 0 or search_samples < 0:
         raise ConfigError('need seeds >= 1, pop size >= 2, generations >= 1, restarts >= 0, '
-                          'global evaluations and runs >= 0 and search samples >= 0')
+                          'global evaluations and runs >= 0, hops >= 0 and search samples '
+                          '>= 0')
     return IdentifySettings(
         pop_size=int(pop_size), maxiter=int(generations), c=float(c), xi=float(xi),
         seeds=tuple(range(int(seed_offset), int(seed_offset) + int(seeds))),
         workers=int(workers), refine=bool(refine), restarts=int(restarts),
         er_bound_percent=er_bound_percent, global_evals=int(global_evals),
-        global_runs=int(global_runs),
+        global_runs=int(global_runs), hops=int(hops),
         search_samples=int(search_samples))
 
 

@@ -88,6 +88,12 @@ class IdentifySettings:
     global_runs : int
         Most runs of the global phase (0: off); 14: the sweep of
         conventions and up to ten longer runs.
+    hops : int
+        With refinement on, when the best seed ends between ``global_factor``
+        and 4 x the floor: the most jumps of basin hopping from it before
+        the global phase, and again from the global phase's best when that
+        improved but is still above (:mod:`hyst_id.identification.hop`;
+        fewer on a record over 5,000 samples). 0: off.
     search_samples : int
         With refinement on, on a record longer than this the GAASS runs, the
         polishes of each run's best chromosomes and of the data-built starts
@@ -117,6 +123,7 @@ class IdentifySettings:
     global_evals: int = 200000
     global_factor: float = 1.1
     global_runs: int = 14
+    hops: int = 100
     search_samples: int = 20000
 
 

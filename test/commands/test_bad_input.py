@@ -168,6 +168,7 @@ CASES = [
                                          '-1'], 'global evaluations'),
     ('negative-search-samples', lambda d: [str(write_csv(d / 'ok7.csv')), '--search-samples',
                                            '-5'], 'search samples'),
+    ('negative-hops', lambda d: [str(write_csv(d / 'ok8.csv')), '--hops', '-1'], 'hops >= 0'),
     ('bad-columns-option', lambda d: [str(write_csv(d / 'ok5.csv')), '--columns', 't,command'],
      'three'),
 ]
