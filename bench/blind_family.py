@@ -182,7 +182,7 @@ def summary(rows: list[dict], how: str = 'one worker each') -> str:
              f'| physical claims on clean recordings | {len(claims)}/{len(clean)} '
              f'({", ".join(sorted({r["verdict"] for r in claims})) or "-"}) | 0 |',
              '| median final held-out / floor (judged rows), recordings with effects | '
-             f'{np.median([r["final"] for r in eff]):.2f} | <= 1.2 |',
+             f'{np.median([r["final"] for r in eff]) if eff else float("nan"):.2f} | <= 1.2 |',
              f'| seconds per recording, median / max (2,000 samples, {how}) | '
              f'{np.median([r["seconds"] for r in rows]):.0f} / '
              f'{max(r["seconds"] for r in rows):.0f} | <= 60 |', '']
