@@ -61,7 +61,7 @@ _LONG_RUN = 3
 #: reference family the traps they got out of were at 1.17-3.65 x before them (#84, #40,
 #: #47, #2, #170 and #44 at 3.65 x, which 1.5 had left out:
 #: docs/data/generalisation_misses_long_runs_4x.jsonl).
-LONG_RUNS_WITHIN = 4.0
+LONG_RUNS_WITHIN = IdentifySettings.long_runs_within   # the default; per call: the settings
 
 
 def global_phase(spec: ChainSpec, rec: Recording, settings: IdentifySettings,
@@ -152,7 +152,7 @@ def global_phases(spec: ChainSpec, others: list[ChainSpec], rec: Recording,
             if j < len(sweep):
                 tasks.append((sweep[j], rec, settings, settings.seeds[0], -1 - j, None,
                               subset))
-            elif best.er_percent <= LONG_RUNS_WITHIN * floor_percent:
+            elif best.er_percent <= settings.long_runs_within * floor_percent:
                 # other streams, longer, under the best fit's conventions
                 phase = replace(spec, initial=best.initial, hold=best.hold)
                 tasks.append((phase, rec, settings, settings.seeds[0], -1 - j,

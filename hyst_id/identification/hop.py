@@ -37,7 +37,6 @@ import numpy as np
 
 from hyst_id.identification.chains import ChainSpec, er_percent
 from hyst_id.identification.gauge import canonical_gauge, output_sign
-from hyst_id.identification.global_phase import LONG_RUNS_WITHIN
 from hyst_id.identification.refine import refine
 from hyst_id.identification.result import IdentifySettings, SeedRun
 from hyst_id.io.recording import Recording
@@ -75,8 +74,8 @@ def hop(spec: ChainSpec, rec: Recording, best: SeedRun, settings: IdentifySettin
         ``hops`` (the most jumps), ``global_factor`` (hopping stops once the
         fit is within this multiple of ``floor_percent``) and ``seeds[0]``
         (the random stream). Nothing is tried unless ``best`` is within
-        :data:`~hyst_id.identification.global_phase.LONG_RUNS_WITHIN` of the
-        floor: further off, the misfit is taken for physics the chain lacks.
+        ``long_runs_within`` x the floor: further off, the misfit is taken
+        for physics the chain lacks.
     floor_percent : float
         The estimated noise floor (%e_r).
     run_id : int
@@ -88,7 +87,7 @@ def hop(spec: ChainSpec, rec: Recording, best: SeedRun, settings: IdentifySettin
     SeedRun or None
     """
     if not (settings.refine and settings.hops > 0 and np.isfinite(best.fun)
-            and best.er_percent <= LONG_RUNS_WITHIN * floor_percent):
+            and best.er_percent <= settings.long_runs_within * floor_percent):
         return None
     spec = replace(spec, initial=best.initial, hold=best.hold)
     t_s, v, y = rec.t_s, rec.command, rec.measurement

@@ -26,7 +26,7 @@ parameters and its inverse's clean corners.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Callable, Sequence
 
 import numpy as np
@@ -162,11 +162,18 @@ def choose_family(recording: Recording, families: Sequence[str] = AUTO_FAMILIES,
         raise IdentificationError(
             f'cannot hold out the last {1 - fit_share:.0%} of the recording to choose the '
             f'family: {exc}; pass a family explicitly') from exc
+    settings = settings or IdentifySettings()
     scores = []
+    # the families are compared on their basins, not on the last per cent of a floor: the
+    # wrong family's fit is off its floor by design, and the longer global runs and
+    # hopping within 4 x would be spent on it (minutes); the chosen family's final fit
+    # gets the whole schedule
+    compare = replace(settings, long_runs_within=min(settings.long_runs_within, 1.5),
+                      global_runs=min(settings.global_runs, 6))
     for fam in fams:
         if progress:
             progress(fam, 'train')
-        ident = identify(train, spec=domains_from_data(train, family=fam), settings=settings,
+        ident = identify(train, spec=domains_from_data(train, family=fam), settings=compare,
                          progress=seed_progress, on_generation=on_generation,
                          should_stop=should_stop)
         tr, ho = holdout_error(ident, rec, train.n_samples)

@@ -78,7 +78,7 @@ class IdentifySettings:
         over the whole box, each refined, join the runs (seeds ``-1``,
         ``-2``, ...) when they do better: one per initial state and sensor
         hold convention with this many evaluations, then, while the fit is
-        within 4 x the floor (``LONG_RUNS_WITHIN``), runs with three times
+        within ``long_runs_within`` x the floor, runs with three times
         as many under the best fit's conventions, in rounds of two until the
         fit reaches
         ``global_factor`` or ``global_runs`` are spent
@@ -88,9 +88,15 @@ class IdentifySettings:
     global_runs : int
         Most runs of the global phase (0: off); 14: the sweep of
         conventions and up to ten longer runs.
+    long_runs_within : float
+        The global phase's longer runs and basin hopping only while the best
+        fit is within this multiple of the floor: further off, the misfit is
+        taken for physics the chain lacks (a choice between H families
+        compares them with 1.5 and 6 runs:
+        :func:`hyst_id.identification.model_choice.choose_family`).
     hops : int
         With refinement on, when the best seed ends between ``global_factor``
-        and 4 x the floor: the most jumps of basin hopping from it before
+        and ``long_runs_within`` x the floor: the most jumps of basin hopping from it before
         the global phase, and again from the global phase's best when that
         improved but is still above (:mod:`hyst_id.identification.hop`;
         fewer on a record over 5,000 samples). 0: off.
@@ -123,6 +129,7 @@ class IdentifySettings:
     global_evals: int = 200000
     global_factor: float = 1.1
     global_runs: int = 14
+    long_runs_within: float = 4.0
     hops: int = 100
     search_samples: int = 20000
 

@@ -124,13 +124,13 @@ class SlidingLink:
             return
         fresh = None
         if p('sliding.fresh_seeds') > 0:
-            # no global phase: a drifting window often ends above 1.1 x the floor, and
-            # the phase's 200,000 evaluations would dwarf fresh_generations
+            # no global phase nor hopping: a drifting window often ends above 1.1 x the
+            # floor, and the phase's 200,000 evaluations would dwarf fresh_generations
             fresh = make_settings(
                 seeds=p('sliding.fresh_seeds'), seed_offset=p('seed_offset'),
                 pop_size=p('pop_size'), generations=p('sliding.fresh_generations'), c=p('c'),
                 xi=p('xi'), workers=1, refine=True, restarts=0, er_bound_percent=None,
-                global_evals=0)
+                global_evals=0, hops=0)
         rule = SwapRule(holdout_s=p('sliding.holdout_s'), min_gain=p('sliding.min_gain'),
                         max_p=p('sliding.max_p'))
         self.job = SlidingJob(node.handed_over, window, rule=rule,
