@@ -123,7 +123,9 @@ def test_restarts_stop_when_they_stop_gaining(simulated):
     drift = 0.05 * np.sin(2 * np.pi * rec.t_s / 37.0) * np.ptp(rec.measurement)
     off = Recording(rec.t_s, rec.command, rec.measurement + drift, 'position', 'mA', '',
                     'position with an unmodelled drift')
-    base = {'seeds': (0,), 'workers': 1, 'maxiter': 60, 'restarts': 4}
+    # the seed's restarts are what is measured: no global phase, no hopping after them
+    base = {'seeds': (0,), 'workers': 1, 'maxiter': 60, 'restarts': 4, 'global_evals': 0,
+            'hops': 0}
     full = identify(off, settings=IdentifySettings(**base, restart_patience=100)).runs[0]
     capped = identify(off, settings=IdentifySettings(**base, restart_patience=1)).runs[0]
     assert full.er_percent > 1.5 * noise_floor_percent(off.measurement)   # restarts wanted
