@@ -30,7 +30,7 @@ from hyst_id.identification.global_phase import LONG_RUNS_WITHIN
 from hyst_id.identification.hop import hop
 from hyst_id.identification.refine import refine
 from hyst_id.identification.result import SeedRun
-from hyst_id.io.recording import Recording
+from hyst_id.io.recording import Recording, roundoff_probe
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / 'bench'))
 import generalisation as FAMILY  # noqa: E402, I100
@@ -47,7 +47,9 @@ TRAP_163 = np.array([
 @pytest.fixture(scope='module')
 def trap():
     case = FAMILY.draw_case(163)
-    rec = Recording(case.t_s, case.command, case.measurement, case.channel, 'u', 'y', '#163')
+    # through the round-off probe, as identify's input is (HYST_ID_ROUNDOFF_PROBE)
+    rec = roundoff_probe(Recording(case.t_s, case.command, case.measurement, case.channel,
+                                   'u', 'y', '#163'))
     spec = replace(domains_from_data(rec), initial='falling', hold='after')
     fun = float(spec.cost_function(rec.t_s, rec.command, rec.measurement)(TRAP_163[None])[0])
     er = float(er_percent(fun, rec.measurement))
