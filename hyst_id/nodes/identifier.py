@@ -49,7 +49,7 @@ from hyst_id.compensation.params_file import (
 )
 from hyst_id.errors import ConfigError, HystIdError
 from hyst_id.identification import Identification, IdentifySettings
-from hyst_id.identification.config import make_settings, make_spec
+from hyst_id.identification.config import make_spec
 from hyst_id.identification.model_choice import AUTO_FAMILIES
 from hyst_id.io.recording import Recording, validate_recording
 from hyst_id.io.topics import get_field, parse_field_path, TopicConfig, value_field
@@ -79,7 +79,8 @@ from hyst_id.nodes.support import (
     spin_node,
     stamp_ns,
 )
-from hyst_id.nodes.support.identifier_params import default_params_out, PARAMS
+from hyst_id.nodes.support.identifier_params import (
+    default_params_out, identify_settings, PARAMS)
 from hyst_id.nodes.support.result_pub import ResultPublisher
 from hyst_id.nodes.support.sliding import SlidingLink
 
@@ -310,12 +311,7 @@ class Identifier(HystNode):
 
     def settings(self) -> IdentifySettings:
         """GAASS settings from the parameters, built as ``hyst-id identify`` builds them."""
-        bound = self.p('er_bound_percent')
-        return make_settings(
-            seeds=self.p('seeds'), seed_offset=self.p('seed_offset'),
-            pop_size=self.p('pop_size'), generations=self.p('generations'), c=self.p('c'),
-            xi=self.p('xi'), workers=self.p('workers'), refine=self.p('refine'),
-            restarts=self.p('restarts'), er_bound_percent=bound if bound > 0 else None)
+        return identify_settings(self.p)
 
     def _kept(self) -> str:
         doc = self.last_document

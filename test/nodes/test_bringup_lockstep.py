@@ -51,6 +51,8 @@ identifier:
     generations: 60
     seeds: 2
     workers: 1
+    global_runs: 6
+    hops: 0
 """
 
 

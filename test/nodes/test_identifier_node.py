@@ -257,6 +257,7 @@ def test_replay_at_rate_4_with_sim_time_keeps_the_sensor_time_constant(ctx, tmp_
     _make(ctx, Identifier, parameter_overrides=[
         Parameter('channel', value='pressure'), Parameter('use_sim_time', value=True),
         Parameter('seeds', value=2), Parameter('generations', value=60),
+        Parameter('global_runs', value=6), Parameter('hops', value=0),
         Parameter('end_of_run_timeout_s', value=1.0), Parameter('compensator_node', value=''),
         Parameter('measurement_reliable', value=True), Parameter('recover_on_start', value=False),
         Parameter('params_out', value=str(tmp_path / 'out.yaml'))])

@@ -138,6 +138,7 @@ def test_defaults_match_the_params_files():
     (Excitation, {'hold_s': -1.0}, 'hold_s'),
     (Identifier, {'domains': '/no/such/domains.yaml'}, 'domains'),
     (Identifier, {'pop_size': 1}, 'pop_size'),
+    (Identifier, {'hops': -1}, 'hops'),
     (Identifier, {'model': 'preisach'}, 'one of'),
     (Identifier, {'model': 'smooth', 'domains': 'paper'}, 'paper'),
     (Identifier, {'model': 'auto', 'domains': 'paper'}, 'domains must be auto'),
@@ -382,7 +383,11 @@ def _identify_now(ctx, out, timeout: float, **params):
 
 def test_identifier_identify_now_publishes_writes_and_matches_identify(ctx, tmp_path):
     out = tmp_path / 'comp.yaml'
-    ident, rec, doc = _identify_now(ctx, out, 120.0, seeds=2, generations=40, domains='paper')
+    ident, rec, doc = _identify_now(ctx, out, 120.0, seeds=2, generations=40, domains='paper',
+                                    global_runs=6, hops=0)
+    # identify's global phase and hopping are the node's parameters too
+    assert (ident.settings().global_runs, ident.settings().hops) == (6, 0)
+    assert ident.settings().global_evals == 200000
     assert doc['channel'] == 'position' and doc['n_samples'] == rec.n_samples
     assert doc['er_percent'] < 1.0
     assert ident.p('identify_now') is False

@@ -48,7 +48,7 @@ from hyst_id.nodes.support import COMMAND_QOS, LATCHED_QOS, stamp_ns  # noqa: E4
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
 GAASS = ['-p', 'seeds:=2', '-p', 'generations:=100', '-p', 'domains:=paper', '-p',
-         'workers:=1']
+         'workers:=1', '-p', 'global_runs:=6', '-p', 'hops:=0']
 
 
 class Graph:
@@ -236,7 +236,8 @@ def test_live_pipeline_then_replay_agrees_with_cli(ros_domain, tmp_path):
         cli = subprocess.run(
             [sys.executable, '-m', 'hyst_id.cli', 'identify', str(bag), '--channel', 'position',
              '--params', str(log_stamps), '--seeds', '2', '--generations', '100', '--workers',
-             '1', '--domains', 'paper', '--quiet', '--json', str(cli_json)],
+             '1', '--domains', 'paper', '--global-runs', '6', '--hops', '0', '--quiet',
+             '--json', str(cli_json)],
             capture_output=True, text=True, timeout=300)
         assert cli.returncode == 0, cli.stderr
         ref = json.loads(cli_json.read_text())

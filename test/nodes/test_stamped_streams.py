@@ -282,6 +282,7 @@ def test_replay_at_rate_4_of_stamped_streams_keeps_tau_without_a_clock(ctx, tmp_
     make_node(ctx, Identifier, parameter_overrides=STAMPED + [
         Parameter('channel', value='pressure'),
         Parameter('seeds', value=2), Parameter('generations', value=60),
+        Parameter('global_runs', value=6), Parameter('hops', value=0),
         Parameter('end_of_run_timeout_s', value=1.0), Parameter('compensator_node', value=''),
         Parameter('measurement_reliable', value=True), Parameter('recover_on_start', value=False),
         Parameter('params_out', value=str(tmp_path / 'out.yaml'))])

@@ -297,6 +297,8 @@ TWO_GRAPHS = """
     channel: {channel}
     generations: 60
     seeds: 2
+    global_runs: 6
+    hops: 0
     gate_max_floor_ratio: 0.0
     gate_max_uncertainty: 0.0
 """

@@ -18,13 +18,27 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
+from typing import Any, Callable
 
+from hyst_id.identification.config import make_settings
+from hyst_id.identification.result import IdentifySettings
 from hyst_id.io.recording import CHANNELS
 from hyst_id.nodes.support.params import field_params, Param, topic_params
 from hyst_id.nodes.support.qos import IDENTIFIED_PARAMS_TOPIC
 from hyst_id.nodes.support.sliding import SLIDING_PARAMS
 
-__all__ = ['PARAMS', 'default_params_out']
+__all__ = ['PARAMS', 'default_params_out', 'identify_settings']
+
+
+def identify_settings(p: Callable[[str], Any]) -> IdentifySettings:
+    """Identify's settings from the node's parameters (``p(name)``), as the CLI builds them."""
+    bound = p('er_bound_percent')
+    return make_settings(
+        seeds=p('seeds'), seed_offset=p('seed_offset'), pop_size=p('pop_size'),
+        generations=p('generations'), c=p('c'), xi=p('xi'), workers=p('workers'),
+        refine=p('refine'), restarts=p('restarts'),
+        er_bound_percent=bound if bound > 0 else None, global_evals=p('global_evals'),
+        global_runs=p('global_runs'), hops=p('hops'))
 
 
 def default_params_out() -> Path:
@@ -67,6 +81,11 @@ PARAMS = [
           'floor and they still gain (0 = one run per seed)', low=0, high=1000),
     Param('er_bound_percent', 0.0, 'stop a GAASS run once %e_r is below this (0 = never)',
           low=0.0, high=1000.0, unit='%'),
+    Param('global_evals', 200000, 'evaluations of each global-phase run while the best fit '
+          'stays above 1.1 x the noise floor (0 = no global phase)', low=0, high=100000000),
+    Param('global_runs', 14, 'most runs of the global phase (0 = none)', low=0, high=1000),
+    Param('hops', 100, 'when the best seed ends between 1.1 and 4 x the noise floor, the most '
+          'jumps of basin hopping from it (0 = none)', low=0, high=100000),
     Param('domains', 'auto', "search domains: 'auto' (from the data), 'paper', or a YAML "
           'file of name: [low, high]'),
     Param('model', 'tk', "H's family: 'tk' (the paper's piecewise-linear loop), 'smooth' "
