@@ -221,8 +221,14 @@ def test_cli_gaass_only_quick(tmp_path, capsys):
 
 @pytest.mark.slow
 def test_paper_settings_beat_all_six_paper_numbers():
-    """Ten seeds, 500 generations, N_pop 10 (the paper's settings), regulation off."""
-    res = run_experiment(PARAMS, settings=IdentifySettings(), seeds=10, regulation=(False,))
+    """Ten seeds, 500 generations, N_pop 10 (the paper's settings), regulation off.
+
+    The paper's GAASS with the refinement, without identify's global phase and hopping
+    (the package's additions for recordings it did not make): the paper's numbers are
+    beaten without them.
+    """
+    res = run_experiment(PARAMS, settings=IdentifySettings(global_evals=0, hops=0), seeds=10,
+                         regulation=(False,))
     sc = res.scenarios['off']
     for (mode, ch), r in sc.channels.items():
         assert r.er['cal_seeds_mean'] < PAPER['er_percent'][ch], (mode, ch)

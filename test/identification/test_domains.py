@@ -225,7 +225,11 @@ def test_narrow_domain_is_reported_on_its_edge(simulated):
     """
     rec, _ = simulated('pressure')
     spec = chain_spec('pressure', domains={'tau_s': (1.0, 20.0)})
-    ident = identify(rec, spec=spec, settings=IdentifySettings(seeds=(0, 1, 2, 3), restarts=0))
+    # GAASS and the refinement only: a bound that excludes the truth keeps the fit off the
+    # floor, and the global phase spends two minutes on longer runs that end on the same
+    # edge (passes in 4 s under probes 1-3 at 1e-12 and 4 at 1e-10)
+    ident = identify(rec, spec=spec, settings=IdentifySettings(
+        seeds=(0, 1, 2, 3), restarts=0, global_evals=0, hops=0))
     warnings = domain_edge_warnings(ident, rec, spec)
     assert any(w.startswith('tau_s sits on the lower edge') for w in warnings), warnings
 

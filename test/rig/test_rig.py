@@ -470,7 +470,9 @@ def test_identification_on_default_rig_reaches_its_floor():
     pos = identify(run.recording('position'), settings=settings)
     assert pos.er_percent < 0.15
     # Data-derived domains are wider than the paper's: seeds spread more on this
-    # nonlinear channel (0.44-1.18 %), so take four.
-    settings = IdentifySettings(seeds=(0, 1, 2, 3))
+    # nonlinear channel (0.44-1.18 %), so take four. The orifice keeps the fit off the
+    # floor, so the global phase's longer runs and hopping (for a fit trapped near the
+    # floor) are left out, as --model auto leaves them out for a family that misses.
+    settings = IdentifySettings(seeds=(0, 1, 2, 3), long_runs_within=1.5, hops=0)
     pres = identify(run.recording('pressure'), settings=settings)
     assert pres.er_percent < 1.0
