@@ -28,6 +28,7 @@ Run from the repository root (about 40 minutes on 2 cores)::
 
     python bench/claim_spreads.py
     python bench/claim_spreads.py --only stiction --seeds 24
+    python bench/claim_spreads.py --only loop_shape --seeds 12 --verbose
 """
 
 from __future__ import annotations
@@ -41,6 +42,7 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / 'test' / 'diagnosis'))
+sys.path.insert(0, str(ROOT / 'test'))
 sys.path.insert(0, str(ROOT))
 
 from hyst_id.diagnosis import diagnose  # noqa: E402
@@ -88,6 +90,39 @@ def synthetic_spreads(mechs: list[str], seeds: list[int], probes: list[int | Non
     _probe(None)
 
 
+def smooth_spreads(seeds: list[int], probes: list[int | None]) -> None:
+    """``loop_shape`` on the smooth reference's curved loops (``test_curved_branches_...``).
+
+    Prints how often it is named, the final held-out %e_r over the noise floor,
+    and the share of the paper chain's held-out excess over the floor that the
+    smooth chain removes.
+    """
+    from test_diagnose import FAST
+    from smooth_reference import smooth_recording
+    print(f'smooth loops (test/smooth_reference.py), seeds {seeds[0]}..{seeds[-1]}, '
+          f'probes {probes}')
+    verdicts, ratios, shares = [], [], []
+    for seed in seeds:
+        for probe in probes:
+            _probe(probe)
+            d = diagnose(smooth_recording(seed)[0], settings=FAST)
+            verdicts.append(d.verdict == 'loop_shape')
+            floor = d.noise_floor_percent
+            b = d.baseline.er_holdout_percent
+            a = d.findings[0].er_holdout_after_percent if d.findings else b
+            ratios.append(a / floor)
+            named = d.verdict == 'loop_shape'
+            shares.append((b - a) / (b - floor) if named and b > floor else float('nan'))
+            if VERBOSE:
+                print(f'  seed {seed} probe {probe}: {d.verdict}, held-out {b:.4g} -> {a:.4g}, '
+                      f'floor {floor:.4g}', flush=True)
+    r, sh = np.array(ratios), np.array(shares)
+    print(f'loop_shape named {sum(verdicts)}/{len(verdicts)}  final/floor min {r.min():.3f} '
+          f'max {r.max():.3f}  excess share removed (named) min {np.nanmin(sh):.2f} '
+          f'max {np.nanmax(sh):.2f}', flush=True)
+    _probe(None)
+
+
 def bag_spreads(probes: list[int | None], names: list[str]) -> None:
     """The concealed bags under round-off probes."""
     from test_concealed_bags import CASES, SETTINGS
@@ -127,9 +162,12 @@ def main() -> int:
     VERBOSE = args.verbose
     probes = [None] + list(range(1, args.probes + 1))
     only = [m for m in args.only.split(',') if m]
-    mechs = [m for m in MECHANISM_IDS if not only or m in only]
+    from test_diagnose import CASES
+    mechs = [m for m in MECHANISM_IDS if (not only or m in only) and m in CASES]
     if mechs and only != ['bags']:
         synthetic_spreads(mechs, list(range(5, 5 + args.seeds)), probes[:2])
+    if not only or 'loop_shape' in only:
+        smooth_spreads(list(range(args.seeds)), probes[:2])
     if not only or 'bags' in only:
         bag_spreads(probes, [b for b in args.bags.split(',') if b])
     return 0

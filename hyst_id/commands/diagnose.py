@@ -76,6 +76,8 @@ def _settings(args: argparse.Namespace):
         raise ConfigError('need --seeds >= 1, --pop-size >= 2 and --generations >= 1')
     if args.max_mechanisms < 1:
         raise ConfigError('--max-mechanisms must be at least 1')
+    if args.hops < 0:
+        raise ConfigError('--hops must be at least 0')
     mechs = None
     if args.mechanisms:
         mechs = tuple(m.strip() for m in args.mechanisms.split(',') if m.strip())
@@ -84,7 +86,7 @@ def _settings(args: argparse.Namespace):
         train_fraction=args.train_fraction,
         seeds=tuple(range(args.seed_offset, args.seed_offset + args.seeds)),
         generations=args.generations, pop_size=args.pop_size, workers=args.workers,
-        mechanisms=mechs, max_mechanisms=args.max_mechanisms)
+        mechanisms=mechs, max_mechanisms=args.max_mechanisms, hops=args.hops)
 
 
 def _write_params(diag, path: str) -> None:

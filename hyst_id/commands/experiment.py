@@ -40,8 +40,8 @@ DEFAULT_PARAMS = 'params/paper_rig.yaml'
 #: ``--quick``: a short GAASS and a light refinement, for tests and smoke runs.
 QUICK_SETTINGS = IdentifySettings(maxiter=150, seeds=(0, 1), restarts=1, refine_top=1,
                                   refine_max_nfev=600)
-#: ``--quick``: one GAASS seed and a short run for the diagnosis of columns (b)/(c).
-QUICK_DIAGNOSIS = DiagnoseSettings(seeds=(0,), generations=120, max_mechanisms=2)
+#: ``--quick``: one GAASS seed, a short run and 20 hops for the diagnosis of columns (b)/(c).
+QUICK_DIAGNOSIS = DiagnoseSettings(seeds=(0,), generations=120, max_mechanisms=2, hops=20)
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

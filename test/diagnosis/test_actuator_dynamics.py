@@ -32,7 +32,8 @@ from hyst_id.io.recording import Recording
 
 pytestmark = pytest.mark.slow
 
-SETTINGS = DiagnoseSettings(seeds=(0,), generations=120, max_mechanisms=1)
+SETTINGS = DiagnoseSettings(seeds=(0,), generations=120, max_mechanisms=1,
+                            hops=20)
 
 
 def _recording(seed: int, zeta: float | None, omega_n: float = 2.5,

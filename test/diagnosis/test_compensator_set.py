@@ -40,7 +40,8 @@ from hyst_id.io.recording import Recording
 
 pytestmark = pytest.mark.slow
 
-SETTINGS = DiagnoseSettings(seeds=(0,), generations=120, max_mechanisms=1)
+SETTINGS = DiagnoseSettings(seeds=(0,), generations=120, max_mechanisms=1,
+                            hops=20)
 H = (1.01, 1.05, 0.10, 0.15, -0.25, 0.50, 14.0, 7.0)
 B = (1.0, -0.15, 0.15)
 T = np.arange(2400) * 0.05

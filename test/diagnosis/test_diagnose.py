@@ -48,7 +48,8 @@ __all__: list[str] = []
 
 #: The paper's induced hysteresis with a small backlash; 0.5 s pressure lag.
 CHAIN = np.array([1.01, 1.05, 0.10, 0.15, -0.25, 0.50, 14.0, 7.0, 1.0, -0.15, 0.15, 0.5])
-FAST = DiagnoseSettings(seeds=(0,), generations=120, max_mechanisms=1)
+FAST = DiagnoseSettings(seeds=(0,), generations=120, max_mechanisms=1,
+                        hops=20)
 
 #: mechanism -> (channel, theta, linear coefficients of the model's columns)
 CASES = {
@@ -140,7 +141,17 @@ def test_curved_branches_are_named_loop_shape(seed):
     assert d.verdict == 'loop_shape', d.report()
     f = d.findings[0]
     assert f.params['er_holdout_smooth'].value == pytest.approx(f.er_holdout_after_percent)
-    assert f.er_holdout_after_percent < 0.7 * f.er_holdout_before_percent
+    # The smooth chain reaches the held-out floor, and removes most of the paper chain's
+    # excess over it. How far the paper chain misses varies (its best fit of seed 1 is
+    # 1.4 x the floor, of seed 0 5.8 x), so the gain is a share of the excess, not a ratio.
+    # Measured over seeds 0-11, unperturbed and one round-off probe
+    # (``bench/claim_spreads.py --only loop_shape --seeds 12 --probes 1``): named 20/24
+    # (seeds 8 and 10 get none: the paper chain is already within 1.04 x held out), final
+    # held-out 0.98-1.04 x the floor, share of the excess removed 0.80-1.16.
+    floor = d.noise_floor_percent
+    assert f.er_holdout_after_percent < 1.1 * floor, d.report()
+    excess = f.er_holdout_before_percent - floor
+    assert f.er_holdout_before_percent - f.er_holdout_after_percent > 0.6 * excess, d.report()
     assert 'curved' in f.explanation and '--model smooth' in f.explanation
 
 
@@ -316,6 +327,22 @@ def test_cli_errors_are_one_line(tmp_path, capsys):
     assert main(['diagnose', str(csv), '--mechanisms', 'supply_decay', '--quiet']) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert 'supply_decay cannot act on the position channel' in err[-1], err
+    assert main(['diagnose', str(csv), '--hops', '-1', '--quiet']) == 2
+    assert '--hops must be at least 0' in capsys.readouterr().err
+
+
+def test_cli_hops_reach_the_baseline():
+    """``diagnose --hops N`` is the baseline's hopping (identify's default, 100)."""
+    import argparse
+
+    from hyst_id.commands import diagnose as command
+    from hyst_id.diagnosis.baseline import _identify_base
+    parser = argparse.ArgumentParser()
+    command.add_arguments(parser)
+    for argv, hops in (([], 100), (['--hops', '0'], 0), (['--hops', '7'], 7)):
+        settings = command._settings(parser.parse_args(['r.csv'] + argv))
+        assert settings.hops == hops and _identify_base(settings)['hops'] == hops
+    assert DiagnoseSettings().hops == 100
 
 
 def test_cli_writes_json_and_figure(tmp_path, capsys):

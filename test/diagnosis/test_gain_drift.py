@@ -34,7 +34,8 @@ pytestmark = pytest.mark.slow
 
 #: One GAASS seed and one round (what ``test_diagnose.FAST`` uses): a single drift is
 #: the first finding or none.
-SETTINGS = DiagnoseSettings(seeds=(0,), generations=120, max_mechanisms=1)
+SETTINGS = DiagnoseSettings(seeds=(0,), generations=120, max_mechanisms=1,
+                            hops=20)
 
 
 def _recording(seed: int, gain_of_t, channel: str = 'position') -> Recording:
