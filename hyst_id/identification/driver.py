@@ -42,7 +42,7 @@ from hyst_id.identification.chains import (
 from hyst_id.identification.domains import domains_from_data
 from hyst_id.identification.gauge import canonical_gauge, output_sign
 from hyst_id.identification.global_phase import global_phase, global_phases
-from hyst_id.identification.hop import hop, HOP_RUN_ID
+from hyst_id.identification.hop import HOP_RUN_ID, hop_with_cost
 from hyst_id.identification.quality import assess
 from hyst_id.identification.refine import refine
 from hyst_id.identification.result import Identification, IdentifySettings, SeedRun
@@ -426,17 +426,21 @@ def identify(recording: Recording, *, spec: ChainSpec | None = None,
     # basin hopping from the best seed; unless it reaches the floor, the global phase starts
     # from the seeds' best as without it (a hopped incumbent would change which conventions
     # its longer runs take: family #170 then missed), and the better of the two is hopped
-    hopped = [h for h in [hop(spec, rec, best, settings, floor)] if h is not None]
+    first, spent = hop_with_cost(spec, rec, best, settings, floor)
+    hopped = [first] if first is not None else []
     at_floor = bool(hopped) and hopped[0].er_percent <= settings.global_factor * floor
     improved = global_phases(spec, others, rec, settings, hopped[0] if at_floor else best,
                              floor, n_workers, should_stop,
                              subset=search_subset(rec.command, settings.search_samples),
                              on_run=on_global_run)
     if improved and improved[-1].fun < min(h.fun for h in hopped + [best]):
-        again = hop(spec, rec, improved[-1], settings, floor, HOP_RUN_ID - 1)
+        again, more = hop_with_cost(spec, rec, improved[-1], settings, floor, HOP_RUN_ID - 1)
         hopped += [again] if again is not None else []
+        spent += more
     ident = summarise(rec, spec, settings, runs + hopped + improved)
-    ident.other_nfev = sum(r.nfev for r in global_runs) - sum(r.nfev for r in improved)
+    # evaluations outside the kept runs: the global runs that did not improve, hops that did not
+    ident.other_nfev = (sum(r.nfev for r in global_runs) - sum(r.nfev for r in improved)
+                        + spent - sum(h.nfev for h in hopped))
     warnings, ident.poorly_determined = assess(ident, rec, spec)
     ident.warnings += warnings
     return ident

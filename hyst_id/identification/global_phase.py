@@ -47,7 +47,7 @@ from hyst_id.identification.result import IdentifySettings, SeedRun
 from hyst_id.identification.workers import map_in_processes
 from hyst_id.io.recording import Recording
 
-__all__ = ['global_phase', 'global_phases', 'LONG_RUNS_WITHIN', 'ROUND']
+__all__ = ['global_phase', 'global_phases', 'LONG_RUNS_WITHIN', 'ROUND', 'run_from_fit']
 
 #: Runs per round of the global phase (fixed, whatever the number of workers).
 ROUND = 2
@@ -96,14 +96,25 @@ def global_phase(spec: ChainSpec, rec: Recording, settings: IdentifySettings,
                                           max_nfev=settings.refine_max_nfev)
     if fun_ref < fun:
         x_raw, fun = x_ref, fun_ref
+    return run_from_fit(spec, rec, x_raw, fun, run_id=run_id,
+                        nfev=(int(res.nit) + 1) * popsize * spec.n_params + int(nfev_ref),
+                        nit=int(res.nit), message='differential evolution (global phase)')
+
+
+def run_from_fit(spec: ChainSpec, rec: Recording, x_raw: np.ndarray, fun: float, *,
+                 run_id: int, nfev: int, nit: int, message: str) -> SeedRun:
+    """A fit of the global phase or of hopping as a :class:`SeedRun`, in the canonical gauge.
+
+    A fit whose calibration gain is zero (no output left to scale) gets an
+    infinite cost, so that no comparison keeps it.
+    """
+    t_s, v, y = rec.t_s, rec.command, rec.measurement
     k, b = spec.fit_calibration(x_raw, t_s, v, y)
     x = canonical_gauge(x_raw, (k, b), spec.family) if k != 0 else x_raw
     return SeedRun(seed=run_id, x_raw=x_raw, x=x, sign=output_sign((k, b)) if k != 0 else 1.0,
                    fun=fun if k != 0 else np.inf, er_percent=float(er_percent(fun, y)),
-                   er_gaass_percent=float('nan'),
-                   nfev=(int(res.nit) + 1) * popsize * spec.n_params + int(nfev_ref),
-                   nit=int(res.nit), best_history=np.zeros(0),
-                   message='differential evolution (global phase)', initial=spec.initial,
+                   er_gaass_percent=float('nan'), nfev=int(nfev), nit=int(nit),
+                   best_history=np.zeros(0), message=message, initial=spec.initial,
                    hold=spec.hold)
 
 

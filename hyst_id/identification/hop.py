@@ -36,12 +36,13 @@ from dataclasses import replace
 import numpy as np
 
 from hyst_id.identification.chains import ChainSpec, er_percent
-from hyst_id.identification.gauge import canonical_gauge, output_sign
+from hyst_id.identification.global_phase import run_from_fit
 from hyst_id.identification.refine import refine
 from hyst_id.identification.result import IdentifySettings, SeedRun
 from hyst_id.io.recording import Recording
 
-__all__ = ['hop', 'HOP_FULL_SAMPLES', 'HOP_MIN', 'HOP_NFEV', 'HOP_RUN_ID', 'HOP_SCALE']
+__all__ = ['hop', 'hop_with_cost', 'HOP_FULL_SAMPLES', 'HOP_MIN', 'HOP_NFEV', 'HOP_RUN_ID',
+           'HOP_SCALE']
 
 #: A jump's standard deviation, as a share of each parameter's box width.
 HOP_SCALE = 0.02
@@ -61,6 +62,16 @@ HOP_MIN = 10
 def hop(spec: ChainSpec, rec: Recording, best: SeedRun, settings: IdentifySettings,
         floor_percent: float, run_id: int = HOP_RUN_ID) -> SeedRun | None:
     """Basin hopping from ``best``: the improved run, or ``None`` when no jump did better.
+
+    As :func:`hop_with_cost` without the evaluations spent.
+    """
+    return hop_with_cost(spec, rec, best, settings, floor_percent, run_id)[0]
+
+
+def hop_with_cost(spec: ChainSpec, rec: Recording, best: SeedRun, settings: IdentifySettings,
+                  floor_percent: float, run_id: int = HOP_RUN_ID
+                  ) -> tuple[SeedRun | None, int]:
+    """Basin hopping from ``best``: the improved run (or ``None``) and the evaluations spent.
 
     Parameters
     ----------
@@ -84,11 +95,15 @@ def hop(spec: ChainSpec, rec: Recording, best: SeedRun, settings: IdentifySettin
 
     Returns
     -------
-    SeedRun or None
+    run : SeedRun or None
+        The improved run (its ``nfev`` is every jump's polish), ``None`` when
+        no jump did better or nothing was tried.
+    nfev : int
+        The residual evaluations of every jump's polish, also when none improved.
     """
     if not (settings.refine and settings.hops > 0 and np.isfinite(best.fun)
             and best.er_percent <= settings.long_runs_within * floor_percent):
-        return None
+        return None, 0
     spec = replace(spec, initial=best.initial, hold=best.hold)
     t_s, v, y = rec.t_s, rec.command, rec.measurement
     lo, hi = spec.bounds[:, 0], spec.bounds[:, 1]
@@ -108,12 +123,7 @@ def hop(spec: ChainSpec, rec: Recording, best: SeedRun, settings: IdentifySettin
         if f_new < fun * (1.0 - 1e-9):
             x, fun, improved = x_new, f_new, True
     if not improved:
-        return None
-    k, b = spec.fit_calibration(x, t_s, v, y)
-    if k == 0:
-        return None
-    return SeedRun(seed=run_id, x_raw=x, x=canonical_gauge(x, (k, b), spec.family),
-                   sign=output_sign((k, b)), fun=fun, er_percent=float(er_percent(fun, y)),
-                   er_gaass_percent=float('nan'), nfev=nfev, nit=0,
-                   best_history=np.zeros(0), message='basin hopping from the best run',
-                   initial=spec.initial, hold=spec.hold)
+        return None, nfev
+    run = run_from_fit(spec, rec, x, fun, run_id=run_id, nfev=nfev, nit=0,
+                       message='basin hopping from the best run')
+    return (run if np.isfinite(run.fun) else None), nfev

@@ -191,8 +191,8 @@ class Identification:
         The chain's initial state and sensor hold convention
         (:attr:`hyst_id.identification.chains.ChainSpec.initial`, ``.hold``).
     other_nfev : int
-        Evaluations of global-phase runs that did not improve (not in ``runs``);
-        :attr:`nfev` counts them with the runs'.
+        Evaluations of global-phase runs and basin hopping that did not improve
+        (not in ``runs``); :attr:`nfev` counts them with the runs'.
     """
 
     channel: str

@@ -27,7 +27,7 @@ from hyst_id.identification import IdentifySettings
 from hyst_id.identification.chains import er_percent
 from hyst_id.identification.domains import domains_from_data
 from hyst_id.identification.global_phase import LONG_RUNS_WITHIN
-from hyst_id.identification.hop import hop
+from hyst_id.identification.hop import hop, hop_with_cost
 from hyst_id.identification.refine import refine
 from hyst_id.identification.result import SeedRun
 from hyst_id.io.recording import Recording, roundoff_probe
@@ -94,3 +94,26 @@ def test_hopping_is_repeatable(trap):
 def test_no_hopping(trap, settings, floor_factor):
     rec, spec, run, _ = trap
     assert hop(spec, rec, run, settings, run.er_percent / floor_factor) is None
+
+
+def test_the_evaluations_of_jumps_are_counted(trap):
+    """The improved run carries every jump's polish; jumps that gain nothing still cost."""
+    rec, spec, run, floor = trap
+    out, nfev = hop_with_cost(spec, rec, run, IdentifySettings(), floor)
+    assert out is not None and out.nfev == nfev > 0
+    # a floor the jumps cannot reach: every one is made, the cost reported without a run
+    _, spent = hop_with_cost(spec, rec, run, IdentifySettings(hops=3), run.er_percent / 3.9)
+    assert spent > 0
+
+
+def test_identify_counts_the_jumps_that_did_not_improve(monkeypatch):
+    """``Identification.nfev`` includes hopping that returned nothing."""
+    from hyst_id.identification import driver, identify
+    case = FAMILY.draw_case(3)
+    rec = Recording(case.t_s, case.command, case.measurement, case.channel, 'u', 'y', '#3')
+    settings = IdentifySettings(seeds=(0,), maxiter=20, restarts=0, global_evals=0)
+    counts = {}
+    for spent in (0, 12345):
+        monkeypatch.setattr(driver, 'hop_with_cost', lambda *a, s=spent: (None, s))
+        counts[spent] = identify(rec, settings=settings).nfev
+    assert counts[12345] - counts[0] == 12345
