@@ -122,8 +122,12 @@ def _progress_bar(args: argparse.Namespace, settings,
         bar.update(1)
         bar.set_postfix_str(f'{"run" if run.seed < 0 else "seed"} {run.seed}: '
                             f'%e_r {run.er_percent:.3f}')
-        if bar.n >= bar.total:
-            bar.close()
 
-    progress.close = bar.close          # the global phase may end before its most runs
+    def hopping(jump: int, jumps: int, er: float) -> None:
+        if not bar.disable:
+            bar.set_postfix_str(f'hopping {jump + 1}/{jumps}: %e_r {er:.3f}')
+
+    progress.close = bar.close          # the caller's, after identify: hopping and the
+    #                                     global phase follow the seeds, and may end early
+    progress.hopping = hopping          # basin hopping between the seeds and the global phase
     return progress

@@ -47,7 +47,7 @@ from hyst_id.identification.quality import assess
 from hyst_id.identification.refine import refine
 from hyst_id.identification.result import Identification, IdentifySettings, SeedRun
 from hyst_id.identification.starts import data_starts
-from hyst_id.identification.workers import map_in_processes
+from hyst_id.identification.workers import map_in_processes, WorkersStopped
 from hyst_id.io.recording import Recording, roundoff_probe, validate_recording
 from hyst_id.signals.noise import noise_floor_percent
 from hyst_id.signals.reversals import reversal_indices
@@ -357,7 +357,9 @@ def identify(recording: Recording, *, spec: ChainSpec | None = None,
     progress : callable, optional
         Called as ``progress(done, total, seed_run)`` after each seed, then
         after each run of the global phase (seeds ``-1``, ``-2``, ...; ``total``
-        then counts the most global runs there can be).
+        then counts the most global runs there can be). If it has an attribute
+        ``hopping``, that is called as ``progress.hopping(jump, jumps,
+        er_percent)`` before each jump of basin hopping.
     on_generation : callable, optional
         Called as ``on_generation(seed, restart, generation, er_percent)``
         after every GAASS generation, when the seeds run in this process
@@ -366,7 +368,8 @@ def identify(recording: Recording, *, spec: ChainSpec | None = None,
         With worker processes: looked at every 0.2 s; when true the
         workers are ended at once and
         :class:`~hyst_id.identification.workers.WorkersStopped` is raised
-        (with ``workers == 1`` raise from ``on_generation`` instead).
+        (with ``workers == 1`` raise from ``on_generation`` instead). Basin
+        hopping, in this process, looks at it before each jump.
 
     Returns
     -------
@@ -426,7 +429,14 @@ def identify(recording: Recording, *, spec: ChainSpec | None = None,
     # basin hopping from the best seed; unless it reaches the floor, the global phase starts
     # from the seeds' best as without it (a hopped incumbent would change which conventions
     # its longer runs take: family #170 then missed), and the better of the two is hopped
-    first, spent = hop_with_cost(spec, rec, best, settings, floor)
+    hopping = getattr(progress, 'hopping', None)
+
+    def on_jump(jump: int, jumps: int, er: float) -> None:
+        if should_stop is not None and should_stop():
+            raise WorkersStopped('stopped on request while hopping')
+        if hopping is not None:
+            hopping(jump, jumps, er)
+    first, spent = hop_with_cost(spec, rec, best, settings, floor, on_jump=on_jump)
     hopped = [first] if first is not None else []
     at_floor = bool(hopped) and hopped[0].er_percent <= settings.global_factor * floor
     improved = global_phases(spec, others, rec, settings, hopped[0] if at_floor else best,
@@ -434,7 +444,8 @@ def identify(recording: Recording, *, spec: ChainSpec | None = None,
                              subset=search_subset(rec.command, settings.search_samples),
                              on_run=on_global_run)
     if improved and improved[-1].fun < min(h.fun for h in hopped + [best]):
-        again, more = hop_with_cost(spec, rec, improved[-1], settings, floor, HOP_RUN_ID - 1)
+        again, more = hop_with_cost(spec, rec, improved[-1], settings, floor, HOP_RUN_ID - 1,
+                                    on_jump=on_jump)
         hopped += [again] if again is not None else []
         spent += more
     ident = summarise(rec, spec, settings, runs + hopped + improved)

@@ -32,6 +32,7 @@ process, so the answer does not depend on the number of workers.
 from __future__ import annotations
 
 from dataclasses import replace
+from typing import Callable
 
 import numpy as np
 
@@ -54,7 +55,7 @@ HOP_RUN_ID = -100
 HOP_NFEV = 1500
 
 #: All ``settings.hops`` jumps up to this many samples; on a longer record proportionally
-#: fewer, at least :data:`HOP_MIN`.
+#: fewer, at least :data:`HOP_MIN` (or ``settings.hops`` when that is fewer).
 HOP_FULL_SAMPLES = 5000
 HOP_MIN = 10
 
@@ -69,7 +70,8 @@ def hop(spec: ChainSpec, rec: Recording, best: SeedRun, settings: IdentifySettin
 
 
 def hop_with_cost(spec: ChainSpec, rec: Recording, best: SeedRun, settings: IdentifySettings,
-                  floor_percent: float, run_id: int = HOP_RUN_ID
+                  floor_percent: float, run_id: int = HOP_RUN_ID,
+                  on_jump: Callable[[int, int, float], None] | None = None
                   ) -> tuple[SeedRun | None, int]:
     """Basin hopping from ``best``: the improved run (or ``None``) and the evaluations spent.
 
@@ -92,6 +94,9 @@ def hop_with_cost(spec: ChainSpec, rec: Recording, best: SeedRun, settings: Iden
     run_id : int
         The seed number the run reports; its random stream is drawn from
         ``(settings.seeds[0], run_id)``.
+    on_jump : callable, optional
+        Called as ``on_jump(done, jumps, er_percent)`` after each jump (the
+        best %e_r so far), for progress displays.
 
     Returns
     -------
@@ -111,10 +116,13 @@ def hop_with_cost(spec: ChainSpec, rec: Recording, best: SeedRun, settings: Iden
     x, fun = np.asarray(best.x_raw, dtype=float), float(best.fun)
     nfev, improved = 0, False
     # a jump's polish costs in proportion to the samples: fewer jumps on a long record
-    jumps = max(HOP_MIN, int(settings.hops * min(1.0, HOP_FULL_SAMPLES / rec.n_samples)))
-    for _ in range(jumps):
+    jumps = min(settings.hops, max(HOP_MIN, int(settings.hops * min(
+        1.0, HOP_FULL_SAMPLES / rec.n_samples))))
+    for done in range(jumps):
         if er_percent(fun, y) <= settings.global_factor * floor_percent:
             break
+        if on_jump is not None:
+            on_jump(done, jumps, float(er_percent(fun, y)))
         jump = np.clip(x + rng.normal(0.0, HOP_SCALE, x.size) * (hi - lo), lo, hi)
         if not spec.feasible(jump[None, :])[0]:
             continue

@@ -114,6 +114,39 @@ def test_identify_counts_the_jumps_that_did_not_improve(monkeypatch):
     settings = IdentifySettings(seeds=(0,), maxiter=20, restarts=0, global_evals=0)
     counts = {}
     for spent in (0, 12345):
-        monkeypatch.setattr(driver, 'hop_with_cost', lambda *a, s=spent: (None, s))
+        monkeypatch.setattr(driver, 'hop_with_cost', lambda *a, s=spent, **k: (None, s))
         counts[spent] = identify(rec, settings=settings).nfev
     assert counts[12345] - counts[0] == 12345
+
+
+def test_identify_shows_and_stops_hopping(monkeypatch):
+    """``progress.hopping`` sees each jump; ``should_stop`` is looked at before it."""
+    from hyst_id.identification import driver, identify
+    from hyst_id.identification.workers import WorkersStopped
+    case = FAMILY.draw_case(3)
+    rec = Recording(case.t_s, case.command, case.measurement, case.channel, 'u', 'y', '#3')
+    settings = IdentifySettings(seeds=(0,), maxiter=20, restarts=0, global_evals=0, workers=1)
+
+    def fake_hop(*args, on_jump=None, **kwargs):
+        for k in range(3):
+            on_jump(k, 3, 1.5)
+        return None, 0
+    monkeypatch.setattr(driver, 'hop_with_cost', fake_hop)
+    seen = []
+
+    def progress(done, total, run):
+        pass
+    progress.hopping = lambda *a: seen.append(a)
+    identify(rec, settings=settings, progress=progress)
+    assert seen == [(0, 3, 1.5), (1, 3, 1.5), (2, 3, 1.5)]
+    with pytest.raises(WorkersStopped, match='hopping'):
+        identify(rec, settings=settings, should_stop=lambda: True)
+
+
+def test_on_jump_is_called_before_each_jump(trap):
+    rec, spec, run, floor = trap
+    calls = []
+    hop_with_cost(spec, rec, run, IdentifySettings(hops=4), run.er_percent / 3.9,
+                  on_jump=lambda *a: calls.append(a))
+    assert [c[:2] for c in calls] == [(k, 4) for k in range(4)]
+    assert all(c[2] <= run.er_percent * (1 + 1e-12) for c in calls)

@@ -1,0 +1,53 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""``hyst-id identify``'s progress bar: seeds, then hopping and the global phase."""
+
+from __future__ import annotations
+
+import argparse
+import io
+
+import numpy as np
+
+from hyst_id.commands.identify import _progress_bar
+from hyst_id.identification import IdentifySettings
+from hyst_id.identification.result import SeedRun
+
+__all__: list[str] = []
+
+
+def _run(seed: int, er: float) -> SeedRun:
+    return SeedRun(seed=seed, x_raw=np.zeros(1), x=np.zeros(1), sign=1.0, fun=er,
+                   er_percent=er, er_gaass_percent=er, nfev=1, nit=1,
+                   best_history=np.zeros(0), message='', initial='rising', hold='none')
+
+
+def test_the_bar_stays_open_after_the_seeds_and_shows_hopping(monkeypatch):
+    err = io.StringIO()
+    monkeypatch.setattr('sys.stderr', err)
+    settings = IdentifySettings(seeds=(0, 1))
+    bar = _progress_bar(argparse.Namespace(quiet=False), settings)
+    bar(1, 2, _run(0, 1.5))
+    bar(2, 2, _run(1, 1.4))
+    bar.hopping(0, 100, 1.4)                     # between the seeds and the global phase
+    bar(3, 16, _run(-1, 1.2))                    # a global run: the total grows
+    bar.close()
+    text = err.getvalue()
+    assert 'hopping 1/100: %e_r 1.400' in text, text
+    assert 'global phase' in text and 'run -1: %e_r 1.200' in text, text
+
+
+def test_quiet_has_no_bar():
+    assert _progress_bar(argparse.Namespace(quiet=True), IdentifySettings()) is None
