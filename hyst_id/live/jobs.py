@@ -145,22 +145,27 @@ class IdentificationJob(BackgroundJob):
         self.seeds = tuple(settings.seeds) * ((len(self.families) + 1) if self.families else 1)
         self.runs: list[SeedRun] = []
         self.generation: dict[str, Any] = {}
+        self.hopping: dict[str, Any] = {}
         self.start()
 
     def work(self) -> Identification:
+        def progress(done: int, total: int, run: SeedRun) -> None:
+            self.runs = self.runs + [run]
+            self.check_cancelled()
+
+        def hopping(jump: int, jumps: int, er: float) -> None:
+            self.hopping = {'hop': jump + 1, 'hops': jumps, 'hop_er_percent': er}
+            self.check_cancelled()
+        progress.hopping = hopping            # identify calls it before each jump
         if self.families:
             self.choice = choose_family(self.rec, self.families, settings=self.settings,
-                                        seed_progress=self._progress,
+                                        seed_progress=progress,
                                         on_generation=self._generation,
                                         should_stop=self._cancel.is_set)
             return self.choice.identification
         return identify(self.rec, spec=self.spec, settings=self.settings,
-                        progress=self._progress, on_generation=self._generation,
+                        progress=progress, on_generation=self._generation,
                         should_stop=self._cancel.is_set)
-
-    def _progress(self, done: int, total: int, run: SeedRun) -> None:
-        self.runs = self.runs + [run]
-        self.check_cancelled()
 
     def _generation(self, seed: int, restart: int, generation: int, er: float) -> None:
         self.generation = {'seed': seed, 'restart': restart, 'generation': generation,
@@ -169,6 +174,9 @@ class IdentificationJob(BackgroundJob):
 
     def progress(self) -> dict[str, Any]:
         """Seeds and global runs done, best %e_r so far, elapsed time; the seed's generation.
+
+        Between the seeds and the global phase, the jump of basin hopping it is
+        on (``hop``, ``hops``, ``hop_er_percent``).
 
         The generation is known when the seeds run in the job's own thread
         (``workers == 1``); a cancel then stops within one generation.
@@ -183,6 +191,8 @@ class IdentificationJob(BackgroundJob):
             out['best_er_percent'] = min(r.er_percent for r in runs)
         if self.generation and len(seeds) < len(self.seeds):
             out.update(self.generation)
+        if self.hopping and len(seeds) == len(self.seeds) and len(runs) == len(seeds):
+            out.update(self.hopping)        # after the seeds, before any global run
         return out
 
 

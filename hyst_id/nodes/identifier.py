@@ -477,6 +477,8 @@ class Identifier(HystNode):
             if 'generation' in prog:
                 msg += (f'; seed {prog["seed"]} run {prog["restart"] + 1} generation '
                         f'{prog["generation"]}, %e_r {prog["seed_er_percent"]:.3f}')
+            if 'hop' in prog:
+                msg += f'; hopping {prog["hop"]}/{prog["hops"]}'
         elif self.last_error:
             level, msg = 2, self.last_error
         elif self._gate_message:

@@ -148,6 +148,33 @@ def test_identification_job_counts_global_runs_apart_from_seeds():
     assert prog['best_er_percent'] == pytest.approx(job.result.er_percent)
 
 
+def test_identification_job_reports_hopping_and_cancels_between_jumps(monkeypatch):
+    """After the seeds the job reports the jump it is on, and a cancel stops between two."""
+    import threading
+
+    from hyst_id.identification import driver
+    started = threading.Event()
+
+    def slow_hop(*args, on_jump=None, **kwargs):
+        for k in range(1000):                        # 1000 jumps of 0.05 s: 50 s if uncancelled
+            on_jump(k, 1000, 1.25)
+            started.set()
+            threading.Event().wait(0.05)
+        return None, 0
+    monkeypatch.setattr(driver, 'hop_with_cost', slow_hop)
+    ct, cv, mt, mv = _streams()
+    rec = pair_streams(ct, cv, mt, mv, 'position')
+    settings = IdentifySettings(seeds=(0,), maxiter=10, refine=False, workers=1)
+    job = IdentificationJob(rec, chain_spec('position'), settings)
+    assert started.wait(60.0)
+    prog = job.progress()
+    assert prog['seeds_done'] == 1 and prog['hops'] == 1000 and prog['hop'] >= 1, prog
+    assert prog['hop_er_percent'] == 1.25
+    job.cancel()
+    assert job.wait(5.0)
+    assert job.cancelled and job.result is None and job.error is None
+
+
 def test_background_job_errors_are_one_line():
     class Boom(BackgroundJob):
         def work(self):
