@@ -44,7 +44,7 @@ from hyst_id.identification.chains import ChainSpec, er_percent
 from hyst_id.identification.gauge import canonical_gauge, output_sign
 from hyst_id.identification.refine import refine
 from hyst_id.identification.result import IdentifySettings, SeedRun
-from hyst_id.identification.workers import map_in_processes
+from hyst_id.identification.workers import map_in_processes, WorkersStopped
 from hyst_id.io.recording import Recording
 
 __all__ = ['global_phase', 'global_phases', 'LONG_RUNS_WITHIN', 'ROUND', 'run_from_fit']
@@ -66,7 +66,8 @@ LONG_RUNS_WITHIN = IdentifySettings.long_runs_within   # the default; per call: 
 
 def global_phase(spec: ChainSpec, rec: Recording, settings: IdentifySettings,
                  seed: int, run_id: int = -1, evals: int | None = None,
-                 subset: np.ndarray | None = None) -> SeedRun:
+                 subset: np.ndarray | None = None,
+                 should_stop: Callable[[], bool] | None = None) -> SeedRun:
     """One differential-evolution run over the whole box, refined: seed ``run_id``.
 
     ``evals`` (default ``settings.global_evals``) bounds its evaluations
@@ -74,7 +75,9 @@ def global_phase(spec: ChainSpec, rec: Recording, settings: IdentifySettings,
     ``refine_max_nfev``. Its random stream is drawn from ``(seed, run_id)``.
     On a long record the search sees the sample indices ``subset``
     (:func:`~hyst_id.identification.driver.search_subset`); the refinement
-    and the returned cost use every sample.
+    and the returned cost use every sample. ``should_stop`` (in this
+    process) is looked at after every generation; when it holds,
+    :class:`~hyst_id.identification.workers.WorkersStopped` is raised.
     """
     from scipy.optimize import differential_evolution
     t_s, v, y = rec.t_s, rec.command, rec.measurement
@@ -88,7 +91,11 @@ def global_phase(spec: ChainSpec, rec: Recording, settings: IdentifySettings,
                                      maxiter=maxiter, popsize=popsize, tol=0.0, atol=0.0,
                                      polish=False, rng=np.random.default_rng(  # -1: as before
                                          [seed, 7] if run_id == -1 else [seed, 7, -run_id]),
-                                     vectorized=True, updating='deferred')
+                                     vectorized=True, updating='deferred',
+                                     callback=None if should_stop is None else
+                                     _stop_callback(should_stop))
+        if should_stop is not None and should_stop():
+            raise WorkersStopped('stopped on request in the global phase')
         x_raw, fun = np.asarray(res.x, dtype=float), float(res.fun)
         if subset is not None:
             fun = float(spec.cost_function(t_s, v, y)(x_raw[None, :])[0])
@@ -99,6 +106,13 @@ def global_phase(spec: ChainSpec, rec: Recording, settings: IdentifySettings,
     return run_from_fit(spec, rec, x_raw, fun, run_id=run_id,
                         nfev=(int(res.nit) + 1) * popsize * spec.n_params + int(nfev_ref),
                         nit=int(res.nit), message='differential evolution (global phase)')
+
+
+def _stop_callback(should_stop: Callable[[], bool]) -> Callable:
+    """A ``differential_evolution`` callback that halts it once ``should_stop()`` holds."""
+    def callback(intermediate_result) -> bool:
+        return bool(should_stop())
+    return callback
 
 
 def run_from_fit(spec: ChainSpec, rec: Recording, x_raw: np.ndarray, fun: float, *,
@@ -142,7 +156,8 @@ def global_phases(spec: ChainSpec, others: list[ChainSpec], rec: Recording,
     n_workers : int
         Processes for a round's runs (results do not depend on it).
     should_stop : callable, optional
-        As for :func:`~hyst_id.identification.workers.map_in_processes`.
+        As for :func:`~hyst_id.identification.workers.map_in_processes`; a run
+        in this process looks at it after each generation.
     subset : numpy.ndarray, optional
         Sample indices the searches see on a long record (:func:`global_phase`).
     on_run : callable, optional
@@ -175,7 +190,7 @@ def global_phases(spec: ChainSpec, others: list[ChainSpec], rec: Recording,
             results = map_in_processes(global_phase, tasks, min(n_workers, len(tasks)),
                                        should_stop=should_stop)
         else:
-            results = [global_phase(*t) for t in tasks]
+            results = [global_phase(*t, should_stop=should_stop) for t in tasks]
         for run in results:        # in task order: ties go to the earlier run
             if on_run is not None:
                 on_run(run)

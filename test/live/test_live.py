@@ -231,3 +231,19 @@ def test_quality_gate_reasons():
     assert len(QualityGate().reasons(ident)) == 1
     assert QualityGate().to_dict([]) == {'passed': True, 'reasons': [], 'max_floor_ratio': 3.0,
                                          'max_uncertainty': 1.0}
+
+
+def test_identification_job_cancels_within_a_global_run():
+    """With ``workers == 1`` a global run runs in the job's thread: a cancel stops it too."""
+    rec = off_chain_recording('position', seed=0)
+    settings = IdentifySettings(seeds=(0,), maxiter=20, restarts=0, workers=1, hops=0,
+                                global_evals=50_000_000, global_runs=1)   # minutes uncancelled
+    job = IdentificationJob(rec, None, settings)
+    deadline = 60.0
+    while job.progress()['seeds_done'] < 1 and deadline > 0:
+        job.wait(0.05)
+        deadline -= 0.05
+    job.wait(1.0)                                    # into the global run
+    job.cancel()
+    assert job.wait(10.0)
+    assert job.cancelled and job.result is None and job.error is None
