@@ -56,17 +56,17 @@ def main() -> int:
     ap.add_argument('--hops', type=int, nargs='+', default=[100, 20])
     args = ap.parse_args()
     calls = []
-    hop = driver.hop
+    hop = driver.hop_with_cost
 
-    def timed(spec, rec, best, settings, floor, *rest):
+    def timed(spec, rec, best, settings, floor, *rest, **kwargs):
         t0 = time.perf_counter()
-        run = hop(spec, rec, best, settings, floor, *rest)
+        run, nfev = hop(spec, rec, best, settings, floor, *rest, **kwargs)
         end = f'{run.er_percent / floor:.3f}' if run is not None else '-'
         calls.append(f'    hop {time.perf_counter() - t0:5.1f} s  {rec.n_samples} samples  '
-                     f'{best.er_percent / floor:.3f} -> {end} x floor')
-        return run
+                     f'{best.er_percent / floor:.3f} -> {end} x floor, {nfev} evaluations')
+        return run, nfev
 
-    driver.hop = timed
+    driver.hop_with_cost = timed
     rec = read_recording(ROOT / 'bags' / args.bag, CASES[args.bag][0])
     name = args.bag
     if args.blind is not None:

@@ -66,9 +66,11 @@ def run(args: argparse.Namespace) -> int:
         print(f'H family {spec.family.id}; search domains ({spec.domain_source}): '
               + format_domains(spec), file=sys.stderr)
         bar = _progress_bar(args, settings)
-        ident = identify(rec, spec=spec, settings=settings, progress=bar)
-        if bar is not None:
-            bar.close()
+        try:
+            ident = identify(rec, spec=spec, settings=settings, progress=bar)
+        finally:
+            if bar is not None:
+                bar.close()
     print(format_table(ident))
     if choice is not None:
         print()
@@ -116,8 +118,8 @@ def _progress_bar(args: argparse.Namespace, settings,
                file=sys.stderr, leave=False)
 
     def progress(done: int, total: int, run) -> None:
-        if total > bar.total:           # the global phase's runs after the seeds
-            bar.total = total
+        if run.seed < 0:                # a global run: its most runs grow the total
+            bar.total = max(bar.total, total, bar.n + 1)
             bar.set_description('GAASS seeds, global phase')
         bar.update(1)
         bar.set_postfix_str(f'{"run" if run.seed < 0 else "seed"} {run.seed}: '
@@ -125,9 +127,11 @@ def _progress_bar(args: argparse.Namespace, settings,
 
     def hopping(jump: int, jumps: int, er: float) -> None:
         if not bar.disable:
-            bar.set_postfix_str(f'hopping {jump + 1}/{jumps}: %e_r {er:.3f}')
+            bar.set_postfix_str(f'hopping {jump + 1}/{jumps}: %e_r {er:.3f}' if jump < jumps
+                                else f'hopped: %e_r {er:.3f}')
 
     progress.close = bar.close          # the caller's, after identify: hopping and the
     #                                     global phase follow the seeds, and may end early
     progress.hopping = hopping          # basin hopping between the seeds and the global phase
+    progress.bar = bar                  # the tqdm bar itself (tests)
     return progress

@@ -359,7 +359,8 @@ def identify(recording: Recording, *, spec: ChainSpec | None = None,
         after each run of the global phase (seeds ``-1``, ``-2``, ...; ``total``
         then counts the most global runs there can be). If it has an attribute
         ``hopping``, that is called as ``progress.hopping(jump, jumps,
-        er_percent)`` before each jump of basin hopping.
+        er_percent)`` before each jump of basin hopping and at its end
+        (``jump == jumps``).
     on_generation : callable, optional
         Called as ``on_generation(seed, restart, generation, er_percent)``
         after every GAASS generation, when the seeds run in this process

@@ -95,8 +95,9 @@ def hop_with_cost(spec: ChainSpec, rec: Recording, best: SeedRun, settings: Iden
         The seed number the run reports; its random stream is drawn from
         ``(settings.seeds[0], run_id)``.
     on_jump : callable, optional
-        Called as ``on_jump(done, jumps, er_percent)`` after each jump (the
-        best %e_r so far), for progress displays.
+        Called as ``on_jump(done, jumps, er_percent)`` before each jump
+        (``done`` jumps made so far, the best %e_r so far) and once at the end
+        with ``done == jumps``, for progress displays; it may raise to stop.
 
     Returns
     -------
@@ -130,6 +131,8 @@ def hop_with_cost(spec: ChainSpec, rec: Recording, best: SeedRun, settings: Iden
         nfev += n
         if f_new < fun * (1.0 - 1e-9):
             x, fun, improved = x_new, f_new, True
+    if on_jump is not None:
+        on_jump(jumps, jumps, float(er_percent(fun, y)))       # the end of hopping
     if not improved:
         return None, nfev
     run = run_from_fit(spec, rec, x, fun, run_id=run_id, nfev=nfev, nit=0,

@@ -151,10 +151,12 @@ class IdentificationJob(BackgroundJob):
     def work(self) -> Identification:
         def progress(done: int, total: int, run: SeedRun) -> None:
             self.runs = self.runs + [run]
+            self.hopping = {}                 # a seed or a global run: hopping is over
             self.check_cancelled()
 
         def hopping(jump: int, jumps: int, er: float) -> None:
-            self.hopping = {'hop': jump + 1, 'hops': jumps, 'hop_er_percent': er}
+            self.hopping = ({'hop': jump + 1, 'hops': jumps, 'hop_er_percent': er}
+                            if jump < jumps else {})       # jump == jumps: hopping ended
             self.check_cancelled()
         progress.hopping = hopping            # identify calls it before each jump
         if self.families:
@@ -175,8 +177,8 @@ class IdentificationJob(BackgroundJob):
     def progress(self) -> dict[str, Any]:
         """Seeds and global runs done, best %e_r so far, elapsed time; the seed's generation.
 
-        Between the seeds and the global phase, the jump of basin hopping it is
-        on (``hop``, ``hops``, ``hop_er_percent``).
+        While basin hopping, the jump it is on (``hop``, ``hops``,
+        ``hop_er_percent``).
 
         The generation is known when the seeds run in the job's own thread
         (``workers == 1``); a cancel then stops within one generation.
@@ -191,8 +193,9 @@ class IdentificationJob(BackgroundJob):
             out['best_er_percent'] = min(r.er_percent for r in runs)
         if self.generation and len(seeds) < len(self.seeds):
             out.update(self.generation)
-        if self.hopping and len(seeds) == len(self.seeds) and len(runs) == len(seeds):
-            out.update(self.hopping)        # after the seeds, before any global run
+        hopping = self.hopping
+        if hopping:                         # hopping now (it is cleared by the next run)
+            out.update(hopping)
         return out
 
 

@@ -49,5 +49,19 @@ def test_the_bar_stays_open_after_the_seeds_and_shows_hopping(monkeypatch):
     assert 'global phase' in text and 'run -1: %e_r 1.200' in text, text
 
 
+def test_model_auto_counts_on_past_its_first_total(monkeypatch):
+    """--model auto: three identifications on one bar; global runs never overrun the total."""
+    err = io.StringIO()
+    monkeypatch.setattr('sys.stderr', err)
+    bar = _progress_bar(argparse.Namespace(quiet=False), IdentifySettings(seeds=(0,)), total=3)
+    for k in range(3):                               # one seed and two global runs each
+        bar(1, 1, _run(0, 2.0))
+        bar(2, 3, _run(-1, 1.9))
+        bar(3, 3, _run(-2, 1.8))
+        assert bar.bar.n <= bar.bar.total, (bar.bar.n, bar.bar.total)
+    bar.close()
+    assert 'global phase' in err.getvalue()
+
+
 def test_quiet_has_no_bar():
     assert _progress_bar(argparse.Namespace(quiet=True), IdentifySettings()) is None

@@ -136,7 +136,7 @@ def test_each_mechanism_is_named(mech):
 @pytest.mark.parametrize('seed', range(2))
 def test_curved_branches_are_named_loop_shape(seed):
     """A smooth (Prandtl-Ishlinskii) loop is a loop shape, not a block after the paper's loop."""
-    rec, floor = smooth_recording(seed)
+    rec, _ = smooth_recording(seed)
     d = diagnose(rec, settings=FAST)
     assert d.verdict == 'loop_shape', d.report()
     f = d.findings[0]

@@ -102,8 +102,8 @@ def test_the_evaluations_of_jumps_are_counted(trap):
     out, nfev = hop_with_cost(spec, rec, run, IdentifySettings(), floor)
     assert out is not None and out.nfev == nfev > 0
     # a floor the jumps cannot reach: every one is made, the cost reported without a run
-    _, spent = hop_with_cost(spec, rec, run, IdentifySettings(hops=3), run.er_percent / 3.9)
-    assert spent > 0
+    out, spent = hop_with_cost(spec, rec, run, IdentifySettings(hops=3), run.er_percent / 3.9)
+    assert (out is None or out.nfev == spent) and spent > 0
 
 
 def test_identify_counts_the_jumps_that_did_not_improve(monkeypatch):
@@ -148,5 +148,5 @@ def test_on_jump_is_called_before_each_jump(trap):
     calls = []
     hop_with_cost(spec, rec, run, IdentifySettings(hops=4), run.er_percent / 3.9,
                   on_jump=lambda *a: calls.append(a))
-    assert [c[:2] for c in calls] == [(k, 4) for k in range(4)]
+    assert [c[:2] for c in calls] == [(k, 4) for k in range(4)] + [(4, 4)]   # 4 jumps, end
     assert all(c[2] <= run.er_percent * (1 + 1e-12) for c in calls)

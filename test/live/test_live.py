@@ -175,6 +175,23 @@ def test_identification_job_reports_hopping_and_cancels_between_jumps(monkeypatc
     assert job.cancelled and job.result is None and job.error is None
 
 
+def test_identification_job_forgets_hopping_once_it_ended(monkeypatch):
+    from hyst_id.identification import driver
+
+    def quick_hop(*args, on_jump=None, **kwargs):
+        on_jump(0, 2, 1.3)
+        on_jump(1, 2, 1.2)
+        on_jump(2, 2, 1.2)                           # the end
+        return None, 0
+    monkeypatch.setattr(driver, 'hop_with_cost', quick_hop)
+    ct, cv, mt, mv = _streams()
+    settings = IdentifySettings(seeds=(0,), maxiter=10, refine=False, workers=1)
+    job = IdentificationJob(pair_streams(ct, cv, mt, mv, 'position'), chain_spec('position'),
+                            settings)
+    assert job.wait(60.0) and job.error is None
+    assert 'hop' not in job.progress() and job.hopping == {}
+
+
 def test_background_job_errors_are_one_line():
     class Boom(BackgroundJob):
         def work(self):
@@ -244,6 +261,8 @@ def test_identification_job_cancels_within_a_global_run():
         job.wait(0.05)
         deadline -= 0.05
     job.wait(1.0)                                    # into the global run
+    prog = job.progress()
+    assert prog['seeds_done'] == 1 and 'global_runs_done' not in prog and not job.done, prog
     job.cancel()
     assert job.wait(10.0)
     assert job.cancelled and job.result is None and job.error is None
