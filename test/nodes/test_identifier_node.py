@@ -202,6 +202,7 @@ def test_diagnose_service_publishes_findings_and_json(ctx):
     from std_srvs.srv import Trigger
     ident = _make(ctx, Identifier, parameter_overrides=FAST + [
         Parameter('diagnose_seeds', value=1), Parameter('diagnose_generations', value=20),
+        Parameter('diagnose_hops', value=20),
         Parameter('diagnose_mechanisms', value='offset_drift, sensor_lag')])
     caller = _make(ctx, Node, 'caller')
     diag = caller.create_client(Trigger, '/identifier/diagnose')
@@ -216,6 +217,7 @@ def test_diagnose_service_publishes_findings_and_json(ctx):
     future = diag.call_async(Trigger.Request())
     assert _spin_until(ctx, future.done, timeout=5.0)
     assert future.result().success, future.result().message
+    assert ident.diag_job.options['hops'] == 20              # diagnose_hops reaches it
     assert _spin_until(ctx, lambda: bool(docs), timeout=120.0), ident.last_error
     assert docs[-1]['verdict'] == 'offset_drift'
 

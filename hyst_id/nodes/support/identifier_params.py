@@ -116,6 +116,9 @@ PARAMS = [
           low=1, high=10000000),
     Param('diagnose_train_fraction', 0.7, 'share of the run the diagnosis fits on (the rest is '
           'held out)', low=0.1, high=0.95),
+    Param('diagnose_hops', 100, "most jumps of basin hopping in the diagnosis baseline's "
+          'identifications (20: about 40 % faster when the chain lacks physics)', low=0,
+          high=100000),
     Param('diagnose_mechanisms', '', "comma-separated mechanism ids to test ('' = the whole "
           'library)'),
     *SLIDING_PARAMS,
