@@ -22,7 +22,7 @@ with its JSON document, its ``/diagnostics`` status and its text report).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -62,6 +62,12 @@ class DiagnoseSettings:
         for nothing, on the blind family's clean #27 they are what makes its
         baseline predict the held-out part (20 do not reach it;
         ``bench/diagnosis_hops.py``). The tests' short settings take 20.
+    should_stop : callable, optional
+        Passed to the baseline's identifications (``identify(should_stop=...)``:
+        looked at before each jump of hopping and each generation of an
+        in-process global run; raises
+        :class:`~hyst_id.identification.workers.WorkersStopped`). Not
+        compared or printed.
     """
 
     train_fraction: float = 0.7
@@ -74,6 +80,7 @@ class DiagnoseSettings:
     criteria: Criteria = field(default_factory=Criteria)
     fit_budget: int = 600
     hops: int = 100
+    should_stop: Callable[[], bool] | None = field(default=None, compare=False, repr=False)
 
 
 @dataclass

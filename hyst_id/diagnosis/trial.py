@@ -84,7 +84,8 @@ def try_all(mechs: list[Mechanism], current: FitResult, data: Data, ctx: Context
     say(f'testing {", ".join(m.id for m in mechs)} in {workers} processes')
     order = sorted(range(len(mechs)), key=lambda i: (
         COSTLY_FIRST.index(mechs[i].id) if mechs[i].id in COSTLY_FIRST else len(COSTLY_FIRST)))
-    one = replace(settings, workers=1)       # a worker does not start workers of its own
+    # a worker does not start workers of its own; a stop check does not cross processes
+    one = replace(settings, workers=1, should_stop=None)
     got = map_in_processes(try_mechanism, [(mechs[i], current, data, ctx, one, loc, chain_starts)
                                            for i in order], workers,
                            on_result=lambda c: say(f'{c.mechanism} fitted'))

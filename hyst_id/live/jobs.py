@@ -227,8 +227,9 @@ class DiagnosisJob(BackgroundJob):
     def work(self) -> Any:
         # heavy: imported in the worker, only when a diagnosis is asked for
         from hyst_id.diagnosis import diagnose, DiagnoseSettings
-        return diagnose(self.rec, settings=DiagnoseSettings(**self.options),
-                        progress=self._progress, **self.kwargs)
+        return diagnose(self.rec, settings=DiagnoseSettings(
+            **self.options, should_stop=self._cancel.is_set),   # inside its identifications
+            progress=self._progress, **self.kwargs)
 
     def _progress(self, message: str) -> None:
         self.step = str(message)

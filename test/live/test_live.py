@@ -31,6 +31,7 @@ from hyst_id.live import (
     BackgroundJob,
     compensator_set,
     diagnosis_statuses,
+    DiagnosisJob,
     IdentificationJob,
     pair_streams,
     recovered_document,
@@ -265,4 +266,28 @@ def test_identification_job_cancels_within_a_global_run():
     assert prog['seeds_done'] == 1 and 'global_runs_done' not in prog and not job.done, prog
     job.cancel()
     assert job.wait(10.0)
+    assert job.cancelled and job.result is None and job.error is None
+
+
+def test_diagnosis_job_cancels_inside_an_identification(monkeypatch):
+    """A cancel reaches the baseline's identify (hopping, an in-process global run)."""
+    import threading
+
+    from hyst_id.diagnosis import baseline
+    from hyst_id.identification.workers import WorkersStopped
+    inside = threading.Event()
+
+    def long_identify(rec, *, spec=None, settings=None, should_stop=None, **kwargs):
+        inside.set()
+        for _ in range(2000):                        # 100 s unless should_stop holds
+            if should_stop is not None and should_stop():
+                raise WorkersStopped('stopped on request')
+            threading.Event().wait(0.05)
+        raise AssertionError('the cancel did not reach identify')
+    monkeypatch.setattr(baseline, 'identify', long_identify)
+    ct, cv, mt, mv = _streams(600)
+    job = DiagnosisJob(pair_streams(ct, cv, mt, mv, 'position'), seeds=1, generations=5)
+    assert inside.wait(60.0)
+    job.cancel()
+    assert job.wait(5.0)
     assert job.cancelled and job.result is None and job.error is None
