@@ -54,7 +54,7 @@ def calls(monkeypatch):
     """Record each global-phase run; each scores ``scores[j]`` (%e_r) in turn."""
     made = []
 
-    def fake(spec, rec, settings, seed, run_id=-1, evals=None, subset=None):
+    def fake(spec, rec, settings, seed, run_id=-1, evals=None, subset=None, should_stop=None):
         made.append((spec.initial, spec.hold, run_id, evals or settings.global_evals))
         return _run(spec, made_scores[len(made) - 1], run_id)
     made_scores = []
