@@ -87,7 +87,7 @@ def baseline_starts(rec_train: Recording, spec: ChainSpec, settings, *, thorough
         ident = identify(rec_train, spec=spec, settings=IdentifySettings(
             **base, conventions=conventions, global_evals=global_evals,
             global_runs=1 if conventions == 'given' else 2),
-            should_stop=getattr(settings, 'should_stop', None))
+            should_stop=settings.should_stop)
         own = [r for r in ident.runs if r.initial == spec.initial]
         if own:
             runs.append(min(own, key=lambda r: r.fun))
@@ -108,4 +108,4 @@ def whole_record_er(rec: Recording, spec: ChainSpec, settings) -> float:
     """
     base = _identify_base(settings)
     return float(identify(rec, spec=spec, settings=IdentifySettings(
-        **base, global_runs=4), should_stop=getattr(settings, 'should_stop', None)).er_percent)
+        **base, global_runs=4), should_stop=settings.should_stop).er_percent)
