@@ -59,7 +59,7 @@ from hyst_id.diagnosis.locate import Localization, locate, noise_std
 from hyst_id.diagnosis.mechanisms import get_mechanisms
 from hyst_id.diagnosis.mechanisms.base import Context, Mechanism
 from hyst_id.diagnosis.model import ComposedModel
-from hyst_id.diagnosis.refit import reidentify
+from hyst_id.diagnosis.refit import contest
 from hyst_id.diagnosis.result import DiagnoseSettings, Diagnosis, Finding
 from hyst_id.diagnosis.select import (
     alternatives_record,
@@ -273,7 +273,22 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
         mech = next(m for m in mechs if m.id == winner.mechanism)
         alternatives = alternatives_record(
             tied, close_calls(comps, winner, tied, data, settings.criteria), data)
-        winner.fit = _reidentified(winner, data, ctx, spec, settings, floor_t, say)
+        first, trained = winner, winner.fit.er_train_percent
+        winner, contested = contest(winner, comps, data, ctx, spec, settings,
+                                    floor_train_percent=floor_t)
+        if winner is not first:
+            mech = next(m for m in mechs if m.id == winner.mechanism)
+            alternatives = [a for a in alternatives if a['mechanism'] != winner.mechanism]
+            alternatives.insert(0, {'mechanism': first.mechanism, 'kind': 'contested',
+                                    'er_holdout_after_percent': first.fit.er_holdout_percent,
+                                    'er_judged_after_percent': contested[0][
+                                        'er_judged_after_percent']})
+            say(f'round {round_no + 1}: {winner.mechanism} takes the round from '
+                f'{first.mechanism} once both chains are re-identified')
+            chain_notes.append(_contest_note(round_no + 1, first, winner, contested))
+        elif winner.fit.er_train_percent != trained:
+            say(f're-identified the chain with {winner.mechanism}: training %e_r '
+                f'{trained:.4g} -> {winner.fit.er_train_percent:.4g}')
         findings.append(finding_from(winner, current, mech, loc, ctx, v_orig))
         findings[-1].alternatives = alternatives
         current = winner.fit
@@ -336,19 +351,13 @@ def _rechosen_note(before: FitResult, after: FitResult, data: Data) -> str:
             'chose between equally good fits')
 
 
-def _reidentified(winner: Comparison, data: Data, ctx: Context, spec: ChainSpec,
-                  settings: DiagnoseSettings, floor_t: float,
-                  say: Callable[[str], None]) -> FitResult:
-    """The accepted fit, or the whole chain re-identified with its blocks (refit module).
-
-    The finding's values and errors are then those of the re-identified model;
-    the criteria that accepted the block were judged on its own fit.
-    """
-    again = reidentify(winner.fit, data, ctx, spec, settings, floor_train_percent=floor_t)
-    if again is not winner.fit:
-        say(f're-identified the chain with {winner.mechanism}: training %e_r '
-            f'{winner.fit.er_train_percent:.4g} -> {again.er_train_percent:.4g}')
-    return again
+def _contest_note(round_no: int, first: Comparison, chosen: Comparison,
+                  contested: list[dict]) -> str:
+    figures = ', '.join(f"{c['mechanism']} {c['er_judged_after_percent']:.4g}" for c in contested)
+    return (f'round {round_no}: {first.mechanism} led on fits made around the current chain, '
+            f"but with each block's chain re-identified {chosen.mechanism} predicts the judged "
+            f'held-out part clearly better (judged %e_r after re-identification: {figures}); '
+            f'the current chain was biased by the missing effect')
 
 
 def _refresh_values(findings: list[Finding], mechs: list[Mechanism], final: FitResult,

@@ -38,6 +38,12 @@ def _alternative_lines(f: Any) -> list[str]:
     lines: list[str] = []
     tied = [a for a in f.alternatives if a.get('kind', 'tied') == 'tied']
     close = [a for a in f.alternatives if a.get('kind') == 'close']
+    for a in f.alternatives:
+        if a.get('kind') == 'contested':
+            lines.append(f'    {a["mechanism"]} led on fits around the earlier chain; '
+                         f're-identified with each block, {f.mechanism} predicts the held-out '
+                         'part better '
+                         f'(judged {_fmt(a["er_judged_after_percent"])} for {a["mechanism"]})')
     if tied:
         lines.append('    also consistent with the data (tied, decided by training BIC '
                      f'and evidence): {_alts(tied)}')
