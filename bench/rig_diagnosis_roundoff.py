@@ -22,8 +22,15 @@ findings, the final held-out %e_r, each finding's alternatives (tied or
 close calls) and the first round's drift blocks with their judged held-out
 %e_r. A verdict that changes between probes is a tie the data do not decide.
 
-Usage: ``python bench/rig_diagnosis_roundoff.py [--channel pressure] [--probes 0 1 2 3]``
-(about a minute per probe).
+With ``--augmented`` each probe runs ``hyst-id experiment``'s column (b)
+instead (:func:`hyst_id.experiment.run.run_experiment` on the one channel,
+two GAASS seeds: (b) depends on the diagnosis only) and prints the verdict,
+the findings and what they became in the compensator, (a)'s and (b)'s %ε_c
+and the desired values' distance from the reference: how far (b)'s figure
+moves with the verdict.
+
+Usage: ``python bench/rig_diagnosis_roundoff.py [--channel pressure] [--probes 0 1 2 3]
+[--augmented]`` (about a minute per probe).
 """
 
 from __future__ import annotations
@@ -50,17 +57,31 @@ print(d.verdict, [f.mechanism for f in d.findings], round(d.final.er_holdout_per
        for f in d.findings], 'round 1 drift blocks (judged held-out %%e_r):', first)
 """
 
+AUGMENTED = """
+from hyst_id.experiment.run import run_experiment
+res = run_experiment('params/paper_rig.yaml', seeds=2, modes=('gaass',), channels=(%r,),
+                     adaptive=True)
+r = res.scenarios['off'].channels[('gaass', %r)]
+a = r.adaptive
+print(a.verdict, [m for m, _ in a.applied], '(a) %%.3g (b) %%.3g' %% (
+      r.eps_c_percent, a.eps_c_augmented_percent),
+      'desired value vs reference (a) / (b) %%.3g / %%.3g' %% a.floor_percent, a.augmentation)
+"""
+
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument('--channel', default='pressure', choices=('position', 'pressure', 'flow'))
     ap.add_argument('--probes', type=int, nargs='+', default=[0, 1, 2, 3])
+    ap.add_argument('--augmented', action='store_true',
+                    help='column (b) of hyst-id experiment per probe, not the diagnosis alone')
     args = ap.parse_args()
+    code = AUGMENTED % (args.channel, args.channel) if args.augmented else ONE % args.channel
     for probe in args.probes:
         env = dict(os.environ, HYST_ID_ROUNDOFF_PROBE=str(probe))
         if probe == 0:
             env.pop('HYST_ID_ROUNDOFF_PROBE')
-        out = subprocess.run([sys.executable, '-c', ONE % args.channel], env=env,
+        out = subprocess.run([sys.executable, '-c', code], env=env,
                              capture_output=True, text=True, check=False)
         line = out.stdout.strip().splitlines()[-1] if out.stdout.strip() else out.stderr[-300:]
         print(f'probe {probe}: {line}', flush=True)

@@ -275,7 +275,8 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
             tied, close_calls(comps, winner, tied, data, settings.criteria), data)
         first, trained = winner, winner.fit.er_train_percent
         winner, contested = contest(winner, comps, data, ctx, spec, settings,
-                                    floor_train_percent=floor_t)
+                                    floor_train_percent=floor_t,
+                                    say=lambda text: say(f'round {round_no + 1}: {text}'))
         if winner is not first:
             mech = next(m for m in mechs if m.id == winner.mechanism)
             alternatives = [a for a in alternatives if a['mechanism'] != winner.mechanism]

@@ -160,7 +160,7 @@ def _reidentify_once(fit: FitResult, data, ctx, spec: ChainSpec, settings,
 
 
 def contest(winner, comps: list, data, ctx, spec: ChainSpec, settings, *,
-            floor_train_percent: float) -> tuple:
+            floor_train_percent: float, say=None) -> tuple:
     """The round's winner re-identified, or a runner-up whose re-identified chain beats it.
 
     Parameters
@@ -171,6 +171,8 @@ def contest(winner, comps: list, data, ctx, spec: ChainSpec, settings, *,
         Every candidate of the round (accepted runners-up are the contestants).
     data, ctx, spec, settings, floor_train_percent
         As :func:`reidentify`.
+    say : callable, optional
+        Progress words (``say(text)``) before each runner-up's re-identification.
 
     Returns
     -------
@@ -194,6 +196,10 @@ def contest(winner, comps: list, data, ctx, spec: ChainSpec, settings, *,
     record = [{'mechanism': winner.mechanism, 'er_judged_after_percent': best_er}]
     chosen = winner
     for c in rivals:
+        if say is not None:
+            ratio = best_er / data.floor_holdout_percent
+            say(f'{winner.mechanism} re-identified stays at {ratio:.2g} x the floor: '
+                f're-identifying {c.mechanism} to compare')
         c.fit = reidentify(c.fit, data, ctx, spec, settings,
                            floor_train_percent=floor_train_percent)
         er = data.judged_er_percent(c.fit)

@@ -79,8 +79,8 @@ class Criteria:
     #: accepted runners-up within this ratio of the winner's judged held-out %e_r are
     #: reported as a judgement call (:func:`close_calls`). On the paper rig's pressure
     #: run the other drift block came 1.12-3.3 x the winner's over four round-off probes
-    #: (``bench/rig_diagnosis_roundoff.py``): 1.25 names the closest case; it cannot
-    #: make a runner-up whose own fit moves with round-off stable
+    #: (1.22-3.2 x at 5b82421; ``bench/rig_diagnosis_roundoff.py``): 1.25 names the
+    #: closest case; it cannot make a runner-up whose own fit moves with round-off stable
     judgement_ratio: float = 1.25
 
 

@@ -88,6 +88,15 @@ def test_a_runner_up_that_re_identifies_clearly_better_takes_the_round(calls):
     assert record[0]['er_judged_after_percent'] == pytest.approx(5.0 * FLOOR)
 
 
+def test_each_runner_ups_re_identification_is_announced(calls):
+    w, r = _comp('offset_drift', 0.9, 5.0 * FLOOR), _comp('gain_drift', 1.43, 1.02 * FLOOR)
+    said: list[str] = []
+    refit.contest(w, [w, r], DATA, None, None, SETTINGS, floor_train_percent=FLOOR,
+                  say=said.append)
+    assert said == ['offset_drift re-identified stays at 5 x the floor: re-identifying '
+                    'gain_drift to compare']
+
+
 def test_a_runner_up_within_the_tie_ratio_does_not(calls):
     w, r = _comp('offset_drift', 0.9, 5.0 * FLOOR), _comp('gain_drift', 1.0, 4.7 * FLOOR)
     chosen, record = _contest(w, r)
