@@ -279,11 +279,10 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
                                     say=lambda text: say(f'round {round_no + 1}: {text}'))
         if winner is not first:
             mech = next(m for m in mechs if m.id == winner.mechanism)
-            alternatives = [a for a in alternatives if a['mechanism'] != winner.mechanism]
-            alternatives.insert(0, {'mechanism': first.mechanism, 'kind': 'contested',
-                                    'er_holdout_after_percent': first.fit.er_holdout_percent,
-                                    'er_judged_after_percent': contested[0][
-                                        'er_judged_after_percent']})
+            # the round's ties and close calls were measured against the former leader
+            alternatives = [{'mechanism': first.mechanism, 'kind': 'contested',
+                             'er_holdout_after_percent': first.fit.er_holdout_percent,
+                             'er_judged_after_percent': contested[0]['er_judged_after_percent']}]
             say(f'round {round_no + 1}: {winner.mechanism} takes the round from '
                 f'{first.mechanism} once both chains are re-identified')
             chain_notes.append(_contest_note(round_no + 1, first, winner, contested))

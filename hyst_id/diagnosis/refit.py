@@ -45,7 +45,8 @@ the missing effect can favour the wrong block there: on the blind family's
 re-identified ``offset_drift`` stops at 5.0 x the noise floor where
 ``gain_drift`` reaches 1.02 x. When the re-identified winner stays above
 :data:`CONTEST_ABOVE` x the floor, the accepted runners-up within
-:data:`CONTEST_RATIO` of its judged error are re-identified too, and one
+:data:`CONTEST_RATIO` of its local judged error (at most :data:`CONTESTANTS`)
+are re-identified too, and one
 that then predicts the judged held-out samples clearly better (by more than
 ``criteria.tie_ratio``) takes the round.
 """
@@ -177,7 +178,8 @@ def contest(winner, comps: list, data, ctx, spec: ChainSpec, settings, *,
     Returns
     -------
     chosen : Comparison
-        ``winner`` or a runner-up, its ``fit`` replaced by the re-identified one.
+        ``winner`` or a runner-up, its ``fit`` replaced by the re-identified one
+        (the runners-up that lose keep their re-identified ``fit`` too).
     contest : list of dict
         Empty when no runner-up was re-identified, else each contestant's
         judged held-out %e_r after re-identification (``winner`` first).

@@ -107,7 +107,7 @@ def test_only_accepted_close_runners_up_contest_and_at_most_two(calls):
     w = _comp('a', 1.0, 5.0 * FLOOR)
     far = _comp('far', 2.5, 0.5 * FLOOR)                  # beyond CONTEST_RATIO
     rejected = _comp('rejected', 1.1, 0.5 * FLOOR, accepted=False)
-    near = [_comp(f'n{k}', 1.0 + 0.1 * k, 4.0 * FLOOR) for k in range(1, 4)]
+    near = [_comp(f'n{k}', 1.0 + 0.1 * k, 4.0 * FLOOR) for k in range(3, 0, -1)]
     chosen, record = _contest(w, far, rejected, *near)
     assert [c['mechanism'] for c in record] == ['a', 'n1', 'n2']
     assert chosen.mechanism == 'n1'
