@@ -48,18 +48,33 @@ def add_output_arguments(parser: argparse.ArgumentParser, what: str, plot: str) 
     parser.add_argument('--plot', metavar=plot.split(':')[0], help=plot.split(':', 1)[-1])
 
 
-def add_settings_arguments(parser: argparse.ArgumentParser) -> None:
-    """GAASS and refinement settings (paper's defaults)."""
+def add_settings_arguments(parser: argparse.ArgumentParser, identify: bool = True) -> None:
+    """GAASS and refinement settings (paper's defaults).
+
+    With ``identify=False`` only what ``diagnose`` passes on to its fits
+    (seeds, population, generations, workers, hops, domains): the
+    identification-only flags are not registered, so giving one is a usage
+    error rather than a flag silently ignored.
+    """
     g = parser.add_argument_group('GAASS (defaults: the paper)')
     g.add_argument('--seeds', type=int, default=10, help='number of seeds (0..N-1)')
     g.add_argument('--seed-offset', type=int, default=0, help='first seed')
     g.add_argument('--pop-size', type=int, default=10)
     g.add_argument('--generations', type=int, default=500)
+    g.add_argument('--workers', type=int, default=0, help='processes (0: one per core)')
+    g.add_argument('--hops', type=int, default=100, metavar='N',
+                   help='when the best seed ends between 1.1 and 4 x the noise floor, the '
+                   'most jumps of basin hopping from it, each polished (default 100; 0 = none)')
+    g.add_argument('--domains', default='auto', metavar='auto|paper|YAML',
+                   help="search domains: derived from the data (auto), the paper's "
+                   'preset (paper), or a YAML mapping name: [low, high] that overrides '
+                   'the derived ones')
+    if not identify:
+        return
     g.add_argument('--c', type=float, default=0.007, help='search-space contraction rate')
     g.add_argument('--xi', type=float, default=0.02, help='mutation subspace coefficient')
     g.add_argument('--er-bound', type=float, default=None,
                    help='stop a run once %%e_r falls below this')
-    g.add_argument('--workers', type=int, default=0, help='processes (0: one per core)')
     g.add_argument('--gaass-only', action='store_true',
                    help='no refinement after GAASS (fidelity to the paper)')
     g.add_argument('--restarts', type=int, default=4,
@@ -72,17 +87,10 @@ def add_settings_arguments(parser: argparse.ArgumentParser) -> None:
                    'fit stays trapped)')
     g.add_argument('--global-runs', type=int, default=14, metavar='N',
                    help='most runs of the global phase (default 14; 0 = none)')
-    g.add_argument('--hops', type=int, default=100, metavar='N',
-                   help='when the best seed ends between 1.1 and 4 x the noise floor, the '
-                   'most jumps of basin hopping from it, each polished (default 100; 0 = none)')
     g.add_argument('--search-samples', type=int, default=20000, metavar='N',
                    help='on a longer record GAASS searches on every k-th sample plus every '
                    'command reversal; refinement and results use all samples '
                    '(default 20000; 0 = search on every sample)')
-    g.add_argument('--domains', default='auto', metavar='auto|paper|YAML',
-                   help="search domains: derived from the data (auto), the paper's "
-                   'preset (paper), or a YAML mapping name: [low, high] that overrides '
-                   'the derived ones')
 
 
 def load_recording(args: argparse.Namespace) -> Recording:

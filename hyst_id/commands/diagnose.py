@@ -47,7 +47,7 @@ __all__ = ['add_arguments', 'run']
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Register the arguments of ``diagnose``."""
     add_recording_arguments(parser)
-    add_settings_arguments(parser)
+    add_settings_arguments(parser, identify=False)
     parser.set_defaults(seeds=2, generations=200)
     g = parser.add_argument_group('diagnosis')
     g.add_argument('--train-fraction', type=float, default=0.7,

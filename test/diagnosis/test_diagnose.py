@@ -334,6 +334,19 @@ def test_cli_errors_are_one_line(tmp_path, capsys):
     assert '--hops must be at least 0' in capsys.readouterr().err
 
 
+@pytest.mark.parametrize('flag', ['--global-runs', '--restarts', '--search-samples',
+                                  '--er-bound', '--global-evals', '--xi'])
+def test_cli_identify_only_flags_are_refused(flag, tmp_path, capsys):
+    """Flags only ``identify`` uses are a usage error for ``diagnose``, not ignored."""
+    with pytest.raises(SystemExit) as stop:
+        main(['diagnose', str(tmp_path / 'r.csv'), flag, '3'])
+    assert stop.value.code == 2
+    assert f'unrecognized arguments: {flag} 3' in capsys.readouterr().err
+    with pytest.raises(SystemExit) as stop:
+        main(['diagnose', str(tmp_path / 'r.csv'), '--gaass-only'])
+    assert stop.value.code == 2
+
+
 def test_cli_hops_reach_the_baseline():
     """``diagnose --hops N`` is the baseline's hopping (identify's default, 100)."""
     import argparse
