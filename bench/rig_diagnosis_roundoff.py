@@ -27,7 +27,11 @@ instead (:func:`hyst_id.experiment.run.run_experiment` on the one channel,
 two GAASS seeds: (b) depends on the diagnosis only) and prints the verdict,
 the findings and what they became in the compensator, (a)'s and (b)'s %ε_c
 and the desired values' distance from the reference: how far (b)'s figure
-moves with the verdict.
+moves with the verdict. More lines say where (b) misses: its mean error
+against the reference per fifth of the reference level, the share of its
+commands at the upper command limit (a level the plant cannot give), and, with an output
+map (``static_nonlinearity``), the share of the run's model targets past the
+travel the map was fitted on (``|z| > 1``, where it continues straight).
 
 Usage: ``python bench/rig_diagnosis_roundoff.py [--channel pressure] [--probes 0 1 2 3]
 [--augmented]`` (about a minute per probe).
@@ -58,14 +62,40 @@ print(d.verdict, [f.mechanism for f in d.findings], round(d.final.er_holdout_per
 """
 
 AUGMENTED = """
+import numpy as np
+import hyst_id.experiment.columns as columns
+from hyst_id.diagnosis.export import compensator_set
 from hyst_id.experiment.run import run_experiment
+seen = {}
+plain = columns.adaptive_columns
+def kept(diagnosis, result, rig, t_s, *rest, desired_augmented=None, **kw):
+    seen.update(diagnosis=diagnosis, t_s=t_s, desired=desired_augmented)
+    return plain(diagnosis, result, rig, t_s, *rest, desired_augmented=desired_augmented, **kw)
+columns.adaptive_columns = kept
 res = run_experiment('params/paper_rig.yaml', seeds=2, modes=('gaass',), channels=(%r,),
                      adaptive=True)
-r = res.scenarios['off'].channels[('gaass', %r)]
+sc = res.scenarios['off']
+r = sc.channels[('gaass', %r)]
 a = r.adaptive
 print(a.verdict, [m for m, _ in a.applied], '(a) %%.3g (b) %%.3g' %% (
       r.eps_c_percent, a.eps_c_augmented_percent),
       'desired value vs reference (a) / (b) %%.3g / %%.3g' %% a.floor_percent, a.augmentation)
+ref = sc.reference.truth[{'position': 'position_clean', 'pressure': 'pressure_clean_pa',
+                          'flow': 'flow_clean_g_s'}[%r]]
+err = a.w_augmented - ref
+fifth = np.minimum((5 * np.argsort(np.argsort(ref))) // ref.size, 4)
+print('    (b) minus reference by fifth of the reference level, low to high (mean):',
+      ' '.join(f'{err[fifth == k].mean():.3g}' for k in range(5)))
+top = a.command_augmented_ma >= res.config.command_limits_ma[1] - 1e-9
+print('    (b) commands at the upper limit, per fifth of the level:',
+      ' '.join(f'{np.mean(top[fifth == k]):.0%%}' for k in range(5)))
+_, aug, _ = compensator_set(seen['diagnosis'])
+if aug.has_output_map:
+    t = seen['t_s']
+    z = np.array([aug.model_target(float(d), float(s - t[0]))
+                  for d, s in zip(seen['desired'], t)])
+    print(f'    output map: targets past the fitted travel |z| > 1: {np.mean(abs(z) > 1):.0%%}, '
+          f'z {z.min():.3g} .. {z.max():.3g}')
 """
 
 
@@ -76,15 +106,17 @@ def main() -> None:
     ap.add_argument('--augmented', action='store_true',
                     help='column (b) of hyst-id experiment per probe, not the diagnosis alone')
     args = ap.parse_args()
-    code = AUGMENTED % (args.channel, args.channel) if args.augmented else ONE % args.channel
+    code = AUGMENTED % ((args.channel,) * 3) if args.augmented else ONE % args.channel
     for probe in args.probes:
         env = dict(os.environ, HYST_ID_ROUNDOFF_PROBE=str(probe))
         if probe == 0:
             env.pop('HYST_ID_ROUNDOFF_PROBE')
         out = subprocess.run([sys.executable, '-c', code], env=env,
                              capture_output=True, text=True, check=False)
-        line = out.stdout.strip().splitlines()[-1] if out.stdout.strip() else out.stderr[-300:]
-        print(f'probe {probe}: {line}', flush=True)
+        lines = out.stdout.strip().splitlines()
+        first = [j for j, line in enumerate(lines) if not line.startswith('    ')]
+        text = '\n'.join(lines[first[-1]:]) if first else out.stderr[-300:]
+        print(f'probe {probe}: {text}', flush=True)
 
 
 if __name__ == '__main__':

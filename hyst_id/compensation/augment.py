@@ -44,7 +44,9 @@ units and seconds:
   ``z`` (the diagnosis's travel normalised to [-1, 1] over the record: only
   with the diagnosis's own set, :func:`hyst_id.diagnosis.export.compensator_set`);
   the desired value is mapped back through its inverse (monotone over
-  ``|z| <= POLY_RANGE`` or refused).
+  ``|z| <= POLY_RANGE`` or refused). Past the fitted travel (``|z| > 1``) the map
+  continues as the straight line of its end slope, not as the cubic
+  (:meth:`Augmentation.output_map`).
 
 What has no in-line correction stays in the plant and the diagnosis report
 says so (``compensation.how``); the compensator's tracking
@@ -151,25 +153,43 @@ class Augmentation:
         """Whether the output map is other than the identity."""
         return self.poly != _IDENTITY_POLY
 
-    def invert_output_map(self, reading: float) -> float:
-        """The model output ``z`` whose mapped reading is ``reading`` (clipped to the range)."""
+    def output_map(self, z: float) -> float:
+        """The mapped reading of model output ``z``: the cubic over the fitted travel.
+
+        Over ``|z| <= 1`` (the diagnosis's travel) the cubic; beyond, the
+        straight line through its end with its end slope. A cubic fitted over
+        the travel says nothing about how the curve bends past it, and
+        continued as a cubic it can flatten so that no command reaches a
+        reading the plant still gives (the paper rig's column (b) in two of four
+        round-off probes: a third of the compensation run's targets lay past
+        the travel, ``docs/RESULTS.md``).
+        """
         c0, c1, c2, c3 = self.poly
+        if abs(z) <= 1.0:
+            return c0 + z * (c1 + z * (c2 + z * c3))
+        end = math.copysign(1.0, z)
+        at_end = c0 + end * (c1 + end * (c2 + end * c3))
+        return at_end + (c1 + 2.0 * c2 * end + 3.0 * c3) * (z - end)
+
+    def invert_output_map(self, reading: float) -> float:
+        """The model output ``z`` whose mapped reading (:meth:`output_map`) is ``reading``.
+
+        Exact beyond the travel (the straight continuation); inside, by bisection
+        (the map is monotone over ``|z| <= POLY_RANGE``, checked on construction).
+        """
         if not self.has_output_map:
             return reading
-
-        def p(z: float) -> float:
-            return c0 + z * (c1 + z * (c2 + z * c3))
-
-        lo, hi = -POLY_RANGE, POLY_RANGE
-        p_lo, p_hi = p(lo), p(hi)
+        c0, c1, c2, c3 = self.poly
+        p_lo, p_hi = self.output_map(-1.0), self.output_map(1.0)
         rising = p_hi > p_lo
         if (reading <= p_lo) == rising:
-            return lo
+            return -1.0 + (reading - p_lo) / (c1 - 2.0 * c2 + 3.0 * c3)
         if (reading >= p_hi) == rising:
-            return hi
+            return 1.0 + (reading - p_hi) / (c1 + 2.0 * c2 + 3.0 * c3)
+        lo, hi = -1.0, 1.0
         for _ in range(60):                    # bisection: monotone, always converges
             mid = 0.5 * (lo + hi)
-            if (p(mid) < reading) == rising:
+            if (c0 + mid * (c1 + mid * (c2 + mid * c3)) < reading) == rising:
                 lo = mid
             else:
                 hi = mid

@@ -197,9 +197,11 @@ POLY = (470.0, 45.0, 8.0, 4.0)          # reading = cubic of z = (linear reading
 def test_an_output_map_is_inverted():
     aug = Augmentation(poly_c0=POLY[0], poly_c1=POLY[1], poly_c2=POLY[2], poly_c3=POLY[3])
 
-    def curved(cmds):
+    def curved(cmds):        # the cubic over the travel |z| <= 1, straight beyond it
         z = (_reading(cmds) - 470.0) / 45.0
-        return POLY[0] + z * (POLY[1] + z * (POLY[2] + z * POLY[3]))
+        zc = np.clip(z, -1.0, 1.0)
+        slope = POLY[1] + 2 * POLY[2] * zc + 3 * POLY[3] * zc * zc
+        return POLY[0] + zc * (POLY[1] + zc * (POLY[2] + zc * POLY[3])) + slope * (z - zc)
 
     z_cal = (K / 45.0, (B0 - 470.0) / 45.0)                 # H and B output z
     z_model = InverseModel.from_vector(canonical_gauge(np.r_[H, B], z_cal))
@@ -210,7 +212,17 @@ def test_an_output_map_is_inverted():
     for d in (430.0, 470.0, 512.5):
         z = aug.invert_output_map(d)
         assert POLY[0] + z * (POLY[1] + z * (POLY[2] + z * POLY[3])) == pytest.approx(d)
-    assert aug.invert_output_map(1e6) == 1.25 and aug.invert_output_map(-1e6) == -1.25
+    # past the fitted travel (|z| > 1) the map is the straight line of its end slope
+    for d in (-1e6, 200.0, 800.0, 1e6):
+        z = aug.invert_output_map(d)
+        assert abs(z) > 1.0 and aug.output_map(z) == pytest.approx(d)
+        end = np.sign(z)
+        slope = POLY[1] + 2 * POLY[2] * end + 3 * POLY[3]
+        assert aug.output_map(z) == pytest.approx(aug.output_map(end) + slope * (z - end))
+    zs = np.linspace(-3.0, 3.0, 601)         # continuous and monotone across the ends
+    mapped_z = np.array([aug.output_map(z) for z in zs])
+    assert np.all(np.diff(mapped_z) > 0) or np.all(np.diff(mapped_z) < 0)
+    assert aug.output_map(1.0 + 1e-9) == pytest.approx(aug.output_map(1.0), abs=1e-6)
     assert 'output map' in aug.describe()
 
 
