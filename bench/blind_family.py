@@ -233,6 +233,21 @@ def moved(old: list[dict], new: list[dict]) -> str:
     return '\n'.join(lines) or 'nothing moved'
 
 
+def write_csv(folder: Path, indices: list[int]) -> int:
+    """Write recordings as CSV with their truth beside them (nothing is diagnosed)."""
+    folder.mkdir(parents=True, exist_ok=True)
+    for i in indices:
+        case = draw(i)
+        path = folder / f'blind_{i}.csv'
+        np.savetxt(path, np.c_[case['t'], case['command'], case['measurement']],
+                   delimiter=',', header='t,command,measurement', comments='')
+        truth = {k: case[k] for k in ('index', 'channel', 'excitation', 'dt_s', 'effects',
+                                      'magnitudes', 'noise_percent_of_span')}
+        (folder / f'blind_{i}.truth.json').write_text(json.dumps(truth, indent=1))
+        print(f'{path}: hyst-id diagnose {path} --channel {case["channel"]}')
+    return 0
+
+
 def main() -> int:
     """Run the family, print and write the tables."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -249,7 +264,14 @@ def main() -> int:
                          '0.05 x) differ between OLD_JSON and docs/diagnosis_blind.json')
     ap.add_argument('--from-json', action='store_true',
                     help='only reprint the tables from docs/diagnosis_blind.json')
+    ap.add_argument('--csv', metavar='DIR',
+                    help='only write the recordings (--indices, else --n) as DIR/blind_<i>.csv '
+                         '(t,command,measurement: for hyst-id diagnose/identify with the '
+                         "recording's --channel) and what was put in as "
+                         'DIR/blind_<i>.truth.json')
     args = ap.parse_args()
+    if args.csv:
+        return write_csv(Path(args.csv), args.indices or list(range(args.n)))
     if args.compare:
         print(moved(json.loads(Path(args.compare).read_text()),
                     json.loads((ROOT / 'docs' / 'diagnosis_blind.json').read_text())))
