@@ -146,7 +146,7 @@ def try_mechanism(m: Mechanism, current: FitResult, data: Data, ctx: Context,
     comp.evidence, comp.where = m.evidence(loc)
     model = fit.model
     theta = model.theta(fit.p, m.id) if m.id in model.slices else np.zeros(0)
-    reason = m.implausible(theta, fit.coef, fit.span, data.noise_std, ctx)
+    reason = m.implausible(theta, fit.coef, fit.span, data.noise_std, ctx, labels=fit.labels)
     if reason and comp.accepted:
         comp.accepted, comp.status = False, f'rejected: {reason}'
     return comp

@@ -72,3 +72,16 @@ def test_creep_is_registered_with_words():
     m = MECHANISMS['creep']
     assert m.names == ('tau_creep_s',) and m.units == ('s',) and 'piezo' in m.physics
     assert m.compensation == 'not in-line'
+
+
+def test_a_slow_share_above_the_whole_travel_is_refused():
+    """c > 1: the fast part moves against the command (a lag in disguise, blind #128)."""
+    creep = MECHANISMS['creep']
+    labels = ['sensor', 'creep:0', 'offset']
+    theta, span = np.array([0.6]), (0.0, 1.0)
+    reason = creep.implausible(theta, np.array([-0.33, 1.33, 0.0]), span, 0.01, None, labels)
+    assert 'more than the whole travel' in reason and '133 %' in reason
+    assert creep.implausible(theta, np.array([0.8, 0.2, 0.0]), span, 0.01, None, labels) == ''
+    # relaxing back (a negative share) is creep too
+    assert creep.implausible(theta, np.array([1.2, -0.2, 0.0]), span, 0.01, None, labels) == ''
+    assert creep.implausible(theta, np.array([-0.33, 1.33, 0.0]), span, 0.01) == ''

@@ -198,13 +198,16 @@ class Mechanism:
         return []
 
     def implausible(self, theta: np.ndarray, coef: np.ndarray, span: tuple[float, float],
-                    noise_std: float, ctx: Context | None = None) -> str:
+                    noise_std: float, ctx: Context | None = None,
+                    labels: Sequence[str] | None = None) -> str:
         """Why the fitted block cannot be what the data show ('' when it can).
 
         A block whose own effect is below what the data can resolve (e.g.
         stick-slip jumps smaller than the noise) may still lower the error by
         letting the chain refit; that gain is not evidence for the block.
-        ``ctx`` (the record's context) gives the bounds of ``theta``.
+        ``ctx`` (the record's context) gives the bounds of ``theta``;
+        ``labels`` name the linear coefficients ``coef`` (``'sensor'``,
+        ``'<mechanism>:<i>'``, ``'offset'``; ``None`` when not known).
         """
         return ''
 

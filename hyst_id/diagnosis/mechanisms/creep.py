@@ -85,13 +85,24 @@ class Creep(Mechanism):
         slow = simulate_first_order(columns[0], t_s, float(theta[0]))
         return columns[:-1] + [slow, columns[-1]]
 
+    def implausible(self, theta, coef, span, noise_std, ctx=None, labels=None) -> str:
+        """A slow share above the whole travel is a lag of the whole response, not creep.
+
+        With ``c > 1`` the fast part ``k (1 - c)`` moves against the command
+        and the slow part overshoots it: a travel that first goes the wrong
+        way. On the blind family's #128 (second-order actuator dynamics and a
+        sensor lag, no creep) the block took round 1 with a 133 % share and
+        the sensor lag's time constant (bench/blind_family.py).
+        """
+        share = _share(coef, labels)
+        if share > 1.0:
+            return (f'slow share {100.0 * share:.0f} % is more than the whole travel: the fast '
+                    'part would move against the command; a lag of the whole response, not creep')
+        return ''
+
     def describe(self, theta, coef, info, ctx) -> dict[str, Quantity]:
         """Time constant and the slow share of the travel."""
-        labels = info['labels']
-        k_fast = float(info['coef'][labels.index('sensor')])
-        k_slow = float(info['coef'][labels.index('creep:0')])
-        total = k_fast + k_slow
-        share = k_slow / total if abs(total) > 1e-300 else float('nan')
+        share = _share(info['coef'], info['labels'])
         return {'tau_creep_s': Quantity(float(theta[0]), 's', 'time constant of the slow part'),
                 'creep_share_percent': Quantity(100.0 * share, '%',
                                                 'share of the final travel that arrives '
@@ -120,6 +131,16 @@ class Creep(Mechanism):
         return ('not compensated in-line: H⁻¹ inverts the rate-independent loop, and the slow '
                 f'{values["creep_share_percent"].value:.1f} % share follows the command '
                 'history; feedback with integral action or a creep operator removes it')
+
+
+def _share(coef, labels) -> float:
+    """The slow share ``k_slow / (k_fast + k_slow)`` (NaN when the labels are not known)."""
+    if labels is None or 'creep:0' not in labels or 'sensor' not in labels:
+        return float('nan')
+    k_fast = float(coef[list(labels).index('sensor')])
+    k_slow = float(coef[list(labels).index('creep:0')])
+    total = k_fast + k_slow
+    return k_slow / total if abs(total) > 1e-300 else float('nan')
 
 
 MECHANISM = Creep()

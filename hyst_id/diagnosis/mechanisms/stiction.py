@@ -120,7 +120,7 @@ class Stiction(Mechanism):
             out.append(p)
         return out
 
-    def implausible(self, theta, coef, span, noise_std, ctx=None) -> str:
+    def implausible(self, theta, coef, span, noise_std, ctx=None, labels=None) -> str:
         """Slips below twice the noise std are not seen as slips.
 
         Such a block only lets the chain refit (a tiny band also acts like a

@@ -69,7 +69,7 @@ class TimeGain(Mechanism):
         """Slowest change (the block is then nearly the identity)."""
         return self.bounds(ctx)[:, 0].copy()
 
-    def implausible(self, theta, coef, span, noise_std, ctx=None) -> str:
+    def implausible(self, theta, coef, span, noise_std, ctx=None, labels=None) -> str:
         """A rate at the slowest end of its search is not a gain that changes.
 
         There the fit wanted a still smaller change of a still more distant
