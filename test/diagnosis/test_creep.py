@@ -75,7 +75,7 @@ def test_creep_is_registered_with_words():
 
 
 def test_a_slow_share_above_the_whole_travel_is_refused():
-    """c > 1: the fast part moves against the command (a lag in disguise, blind #128)."""
+    """A share c > 1: the fast part moves against the command (a lag in disguise, #128)."""
     creep = MECHANISMS['creep']
     labels = ['sensor', 'creep:0', 'offset']
     theta, span = np.array([0.6]), (0.0, 1.0)
