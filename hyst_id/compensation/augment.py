@@ -168,8 +168,12 @@ class Augmentation:
         if abs(z) <= 1.0:
             return c0 + z * (c1 + z * (c2 + z * c3))
         end = math.copysign(1.0, z)
-        at_end = c0 + end * (c1 + end * (c2 + end * c3))
-        return at_end + (c1 + 2.0 * c2 * end + 3.0 * c3) * (z - end)
+        return self.output_map(end) + self._end_slope(end) * (z - end)
+
+    def _end_slope(self, end: float) -> float:
+        """The cubic's slope at ``end`` (+1 or -1): the straight continuation's."""
+        _, c1, c2, c3 = self.poly
+        return c1 + 2.0 * c2 * end + 3.0 * c3
 
     def invert_output_map(self, reading: float) -> float:
         """The model output ``z`` whose mapped reading (:meth:`output_map`) is ``reading``.
@@ -179,17 +183,16 @@ class Augmentation:
         """
         if not self.has_output_map:
             return reading
-        c0, c1, c2, c3 = self.poly
         p_lo, p_hi = self.output_map(-1.0), self.output_map(1.0)
         rising = p_hi > p_lo
         if (reading <= p_lo) == rising:
-            return -1.0 + (reading - p_lo) / (c1 - 2.0 * c2 + 3.0 * c3)
+            return -1.0 + (reading - p_lo) / self._end_slope(-1.0)
         if (reading >= p_hi) == rising:
-            return 1.0 + (reading - p_hi) / (c1 + 2.0 * c2 + 3.0 * c3)
+            return 1.0 + (reading - p_hi) / self._end_slope(1.0)
         lo, hi = -1.0, 1.0
         for _ in range(60):                    # bisection: monotone, always converges
             mid = 0.5 * (lo + hi)
-            if (c0 + mid * (c1 + mid * (c2 + mid * c3)) < reading) == rising:
+            if (self.output_map(mid) < reading) == rising:
                 lo = mid
             else:
                 hi = mid
