@@ -59,7 +59,7 @@ from hyst_id.diagnosis.locate import Localization, locate, noise_std
 from hyst_id.diagnosis.mechanisms import get_mechanisms
 from hyst_id.diagnosis.mechanisms.base import Context, Mechanism
 from hyst_id.diagnosis.model import ComposedModel
-from hyst_id.diagnosis.refit import contest, REFIT_ABOVE
+from hyst_id.diagnosis.refit import contest
 from hyst_id.diagnosis.result import DiagnoseSettings, Diagnosis, Finding
 from hyst_id.diagnosis.select import (
     alternatives_record,
@@ -274,9 +274,6 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
         alternatives = alternatives_record(
             tied, close_calls(comps, winner, tied, data, settings.criteria), data)
         first, trained = winner, winner.fit.er_train_percent
-        if trained > REFIT_ABOVE * floor_t:      # minutes on a long record: say so first
-            say(f'round {round_no + 1}: re-identifying the chain with {winner.mechanism} '
-                '(its blocks undone, the chain identified afresh)')
         winner, contested = contest(winner, comps, data, ctx, spec, settings,
                                     floor_train_percent=floor_t,
                                     say=lambda text: say(f'round {round_no + 1}: {text}'))

@@ -94,7 +94,7 @@ def undone_record(fit: FitResult, data, ctx) -> tuple[np.ndarray, np.ndarray, li
 
 
 def reidentify(fit: FitResult, data, ctx, spec: ChainSpec, settings, *,
-               floor_train_percent: float) -> FitResult:
+               floor_train_percent: float, say=None) -> FitResult:
     """The model of ``fit`` with its chain identified afresh on the record with blocks undone.
 
     Parameters
@@ -112,6 +112,9 @@ def reidentify(fit: FitResult, data, ctx, spec: ChainSpec, settings, *,
     floor_train_percent : float
         %e_r of the noise alone on the training part: a fit within
         :data:`REFIT_ABOVE` times it is returned as it is.
+    say : callable, optional
+        Progress words (``say(text)``) before each identification of the chain
+        (minutes on a long record).
 
     Returns
     -------
@@ -125,7 +128,7 @@ def reidentify(fit: FitResult, data, ctx, spec: ChainSpec, settings, *,
         return fit
     local = fit
     for global_phase in (False, True):
-        fit = _reidentify_once(fit, data, ctx, spec, settings, global_phase)
+        fit = _reidentify_once(fit, data, ctx, spec, settings, global_phase, say)
         if fit.er_train_percent <= REFIT_ABOVE * floor_train_percent:
             break
     if data.n_holdout and data.judged_er_percent(fit) > data.judged_er_percent(local):
@@ -134,11 +137,14 @@ def reidentify(fit: FitResult, data, ctx, spec: ChainSpec, settings, *,
 
 
 def _reidentify_once(fit: FitResult, data, ctx, spec: ChainSpec, settings,
-                     global_phase: bool) -> FitResult:
+                     global_phase: bool, say=None) -> FitResult:
     model = fit.model
     v, y, done = undone_record(fit, data, ctx)
     if not done:
         return fit
+    if say is not None:
+        how = "with identify's global phase" if global_phase else 'with GAASS seeds'
+        say(f're-identifying the chain {how} on the record with {", ".join(done)} undone')
     n = data.n_train
     rec = Recording(data.t_s[:n], v[:n], y[:n], ctx.channel)
     try:
@@ -173,7 +179,8 @@ def contest(winner, comps: list, data, ctx, spec: ChainSpec, settings, *,
     data, ctx, spec, settings, floor_train_percent
         As :func:`reidentify`.
     say : callable, optional
-        Progress words (``say(text)``) before each runner-up's re-identification.
+        Progress words (``say(text)``) before each identification of the winner's
+        chain and before each runner-up's re-identification.
 
     Returns
     -------
@@ -186,7 +193,7 @@ def contest(winner, comps: list, data, ctx, spec: ChainSpec, settings, *,
     """
     local = {id(c): data.judged_er_percent(c.fit) for c in comps}
     winner.fit = reidentify(winner.fit, data, ctx, spec, settings,
-                            floor_train_percent=floor_train_percent)
+                            floor_train_percent=floor_train_percent, say=say)
     best_er = data.judged_er_percent(winner.fit)
     if best_er <= CONTEST_ABOVE * data.floor_holdout_percent:
         return winner, []

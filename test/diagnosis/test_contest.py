@@ -56,7 +56,7 @@ def calls(monkeypatch):
     """``reidentify`` replaced: a fit's ``after`` becomes its judged error; calls recorded."""
     seen: list[float] = []
 
-    def fake(fit, data, ctx, spec, settings, *, floor_train_percent):
+    def fake(fit, data, ctx, spec, settings, *, floor_train_percent, say=None):
         seen.append(fit.judged)
         return SimpleNamespace(judged=fit.after, after=fit.after)
 

@@ -129,7 +129,11 @@ def _local_fit(seed: int, probe: int | None = None):
 @pytest.mark.parametrize('seed', STUCK_SEEDS)
 def test_a_drift_block_reidentified_reaches_the_floor(seed):
     data, ctx, spec, local, floor = _local_fit(seed)
-    again = reidentify(local, data, ctx, spec, DiagnoseSettings(), floor_train_percent=floor)
+    said: list[str] = []
+    again = reidentify(local, data, ctx, spec, DiagnoseSettings(), floor_train_percent=floor,
+                       say=said.append)
+    assert said and said[0] == ('re-identifying the chain with GAASS seeds on the record '
+                                'with gain_drift undone')
     assert again.sse_train <= local.sse_train
     assert again.er_train_percent <= 1.1 * floor, (local.er_train_percent / floor,
                                                    again.er_train_percent / floor)
