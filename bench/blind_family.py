@@ -44,12 +44,23 @@ Run from the repository root (about 55 minutes for 150 recordings on 2 cores)::
     python bench/blind_family.py --from-json     # the tables again, from the last run
     git show REV:docs/diagnosis_blind.json > old.json
     python bench/blind_family.py --compare old.json  # what moved since REV's run
+    python bench/blind_family.py --stop-after-min 45   # a part of the run, resumed later
+
+A full run keeps every finished recording in ``docs/diagnosis_blind.partial.jsonl``
+with a hash of the code that decides its row (``hyst_id``, the reference simulator,
+the family's draw); a later full run on the same code skips those and goes on, so a
+slow machine can run the family in parts (``--stop-after-min``: no new recording is
+started after that many minutes). Rows of other code are dropped. When all are done the
+tables are written and the partial file removed. The seconds per recording then come
+from several sessions, each measured the same way.
 """
 
 from __future__ import annotations
 
 import argparse
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+import hashlib
+import inspect
 import json
 from pathlib import Path
 import sys
@@ -273,6 +284,69 @@ def write_csv(folder: Path, indices: list[int]) -> int:
     return 0
 
 
+PARTIAL = ROOT / 'docs' / 'diagnosis_blind.partial.jsonl'
+
+
+def code_hash() -> str:
+    """Hash of what decides a row: ``hyst_id``, the reference simulator, the draw."""
+    h = hashlib.sha256()
+    files = sorted([*(ROOT / 'hyst_id').rglob('*.py'),
+                    *(ROOT / 'test' / 'reference_sim').rglob('*.py'),
+                    ROOT / 'test' / 'excitations.py', ROOT / 'bench' / 'generalisation.py'])
+    for f in files:
+        h.update(str(f.relative_to(ROOT)).encode() + b'\0' + f.read_bytes())
+    for fn in (draw, run):
+        h.update(inspect.getsource(fn).encode())
+    return h.hexdigest()[:16]
+
+
+def finished_rows(code: str) -> list[dict]:
+    """Rows of an earlier part of the run on the same code (others are dropped)."""
+    if not PARTIAL.exists():
+        return []
+    rows = [json.loads(line) for line in PARTIAL.read_text().splitlines() if line.strip()]
+    kept = [r for r in rows if r.get('code') == code]
+    if len(kept) < len(rows):
+        print(f'{len(rows) - len(kept)} rows of other code dropped from {PARTIAL.name}')
+    return kept
+
+
+def run_parts(indices: list[int], workers: int, stop_after_s: float, keep: bool) -> list[dict]:
+    """Diagnose ``indices`` in ``workers`` processes; append each row to the partial file."""
+    code = code_hash()
+    rows = [r for r in finished_rows(code) if r['index'] in indices] if keep else []
+    done = {r['index'] for r in rows}
+    todo = [i for i in indices if i not in done]
+    if done:
+        print(f'{len(done)} recordings from earlier parts on this code ({code}); '
+              f'{len(todo)} to go')
+    t0 = time.time()
+    with ProcessPoolExecutor(workers) as pool:
+        running: set = set()
+        while todo or running:
+            while todo and len(running) < workers and time.time() - t0 < stop_after_s:
+                running.add(pool.submit(run, todo.pop(0)))
+            if not running:
+                break
+            finished, running = wait(running, return_when=FIRST_COMPLETED)
+            for fut in finished:
+                r = fut.result()
+                rows.append(r)
+                if keep:
+                    with PARTIAL.open('a') as f:
+                        f.write(json.dumps(dict(r, code=code)) + '\n')
+                _say(r, len(rows), len(indices), t0)
+    return sorted(rows, key=lambda r: r['index'])
+
+
+def _say(r: dict, k: int, n: int, t0: float) -> None:
+    print(f'[{k}/{n} {time.time() - t0:.0f} s] #{r["index"]} '
+          f'{r["channel"]} {r["excitation"]} {1 / r["dt_s"]:g} Hz '
+          f'{"+".join(r["effects"]) or "clean"} (cost {r["cost"]:.1f} x) -> '
+          f'{"+".join(r["found"]) or r["verdict"]} (final {r["final"]:.2f} x, '
+          f'{r["seconds"]:.0f} s)', flush=True)
+
+
 def main() -> int:
     """Run the family, print and write the tables."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -294,6 +368,9 @@ def main() -> int:
                          '(t,command,measurement: for hyst-id diagnose/identify with the '
                          "recording's --channel) and what was put in as "
                          'DIR/blind_<i>.truth.json')
+    ap.add_argument('--stop-after-min', type=float, default=float('inf'), metavar='M',
+                    help='start no new recording after M minutes (a full run resumes from '
+                         'docs/diagnosis_blind.partial.jsonl next time)')
     args = ap.parse_args()
     if args.csv:
         return write_csv(Path(args.csv), args.indices or list(range(args.n)))
@@ -304,27 +381,30 @@ def main() -> int:
     if args.from_json:
         print(summary(json.loads((ROOT / 'docs' / 'diagnosis_blind.json').read_text())))
         return 0
-    rows, t0 = [], time.time()
     indices = args.indices or list(range(args.n))
     k = args.diagnose_workers
     how = 'one worker each' if k <= 1 else f'one at a time in {k} processes'
-    with ProcessPoolExecutor(args.workers) as pool:
-        results = pool.map(run, indices) if k <= 1 else (run(i, k) for i in indices)
-        for r in results:
-            rows.append(r)
-            print(f'[{len(rows)}/{len(indices)} {time.time() - t0:.0f} s] #{r["index"]} '
-                  f'{r["channel"]} {r["excitation"]} {1 / r["dt_s"]:g} Hz '
-                  f'{"+".join(r["effects"]) or "clean"} (cost {r["cost"]:.1f} x) -> '
-                  f'{"+".join(r["found"]) or r["verdict"]} (final {r["final"]:.2f} x, '
-                  f'{r["seconds"]:.0f} s)', flush=True)
+    full = not (args.no_write or args.indices)
+    if k <= 1:
+        rows = run_parts(indices, args.workers, 60.0 * args.stop_after_min, keep=full)
+    else:
+        rows, t0 = [], time.time()
+        for i in indices:
+            rows.append(run(i, k))
+            _say(rows[-1], len(rows), len(indices), t0)
+    if len(rows) < len(indices):
+        print(f'stopped after {len(rows)}/{len(indices)} recordings; run again to go on')
+        return 0
     text = summary(rows, how)
     print(text)
-    if not (args.no_write or args.indices):
-        (ROOT / 'docs' / 'diagnosis_blind.json').write_text(json.dumps(rows, indent=1))
+    if full:
+        (ROOT / 'docs' / 'diagnosis_blind.json').write_text(json.dumps(
+            [{key: v for key, v in r.items() if key != 'code'} for r in rows], indent=1))
         (ROOT / 'docs' / 'diagnosis_blind.md').write_text(
             '# Blind diagnosis on the reference family (issue 14)\n\nWritten by '
             f'`python bench/blind_family.py --n {args.n}`; see the docstring of the script '
             'for the family.\n\n' + text + '\n')
+        PARTIAL.unlink(missing_ok=True)
     return 0
 
 
