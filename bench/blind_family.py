@@ -300,21 +300,27 @@ def code_hash() -> str:
     return h.hexdigest()[:16]
 
 
-def finished_rows(code: str) -> list[dict]:
+def finished_rows(code: str, partial: Path = PARTIAL) -> list[dict]:
     """Rows of an earlier part of the run on the same code (others are dropped)."""
-    if not PARTIAL.exists():
+    if not partial.exists():
         return []
-    rows = [json.loads(line) for line in PARTIAL.read_text().splitlines() if line.strip()]
+    rows = [json.loads(line) for line in partial.read_text().splitlines() if line.strip()]
     kept = [r for r in rows if r.get('code') == code]
     if len(kept) < len(rows):
-        print(f'{len(rows) - len(kept)} rows of other code dropped from {PARTIAL.name}')
+        print(f'{len(rows) - len(kept)} rows of other code dropped from {partial.name}')
     return kept
 
 
-def run_parts(indices: list[int], workers: int, stop_after_s: float, keep: bool) -> list[dict]:
-    """Diagnose ``indices`` in ``workers`` processes; append each row to the partial file."""
-    code = code_hash()
-    rows = [r for r in finished_rows(code) if r['index'] in indices] if keep else []
+def run_parts(indices: list[int], workers: int, stop_after_s: float, keep: bool, *,
+              partial: Path = PARTIAL, one=None, code: str | None = None) -> list[dict]:
+    """Diagnose ``indices`` in ``workers`` processes; append each row to ``partial``.
+
+    ``one`` (default :func:`run`) makes a row from an index; ``code`` (default
+    :func:`code_hash`) marks the rows this code makes.
+    """
+    one = run if one is None else one
+    code = code_hash() if code is None else code
+    rows = [r for r in finished_rows(code, partial) if r['index'] in indices] if keep else []
     done = {r['index'] for r in rows}
     todo = [i for i in indices if i not in done]
     if done:
@@ -325,7 +331,7 @@ def run_parts(indices: list[int], workers: int, stop_after_s: float, keep: bool)
         running: set = set()
         while todo or running:
             while todo and len(running) < workers and time.time() - t0 < stop_after_s:
-                running.add(pool.submit(run, todo.pop(0)))
+                running.add(pool.submit(one, todo.pop(0)))
             if not running:
                 break
             finished, running = wait(running, return_when=FIRST_COMPLETED)
@@ -333,7 +339,7 @@ def run_parts(indices: list[int], workers: int, stop_after_s: float, keep: bool)
                 r = fut.result()
                 rows.append(r)
                 if keep:
-                    with PARTIAL.open('a') as f:
+                    with partial.open('a') as f:
                         f.write(json.dumps(dict(r, code=code)) + '\n')
                 _say(r, len(rows), len(indices), t0)
     return sorted(rows, key=lambda r: r['index'])

@@ -1,0 +1,84 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""The blind family's bookkeeping: scoring with judgement calls, and running in parts."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+import sys
+
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / 'bench'))
+
+import blind_family  # noqa: E402, I100
+
+
+def fake_row(index: int) -> dict:
+    """A row without a diagnosis (module level: the pool pickles it by name)."""
+    return {'index': index, 'channel': 'position', 'excitation': 'chirp', 'dt_s': 0.05,
+            'effects': [], 'verdict': 'none', 'found': [], 'calls': [], 'cost': 1.0,
+            'final': 1.0, 'seconds': 0.0}
+
+
+def _row(effects, found, calls):
+    return {'effects': effects, 'found': found, 'calls': calls, 'verdict': 'x'}
+
+
+@pytest.mark.parametrize('effects, found, calls, right', [
+    (['gain_drift'], ['offset_drift'], [['gain_drift']], True),
+    (['gain_drift'], ['offset_drift'], [[]], False),
+    (['a', 'b'], ['a'], [['b']], False),            # one finding cannot stand for two
+    (['a', 'b'], ['a', 'c'], [[], ['b']], True),
+    (['a'], ['a', 'c'], [[], ['d']], False),        # a second claim with no effect in it
+    (['a'], ['a'], [[]], True),
+])
+def test_a_stated_judgement_call_counts_only_where_it_names_the_effect(
+        effects, found, calls, right):
+    """Each finding must be an effect or state one as its alternative, and cover them all."""
+    assert blind_family._right_or_called(_row(effects, found, calls)) is right
+
+
+def test_a_row_from_before_calls_were_recorded_counts_as_named_right():
+    """Old rows have no ``calls``: they are scored by the names alone."""
+    row = {'effects': ['a'], 'found': ['b'], 'verdict': 'b'}
+    assert blind_family._right_or_called(row) is False
+    assert blind_family._right_or_called(dict(row, found=['a'], verdict='a')) is True
+
+
+def test_a_run_in_parts_goes_on_from_rows_of_the_same_code_only(tmp_path):
+    """Rows of the same code are kept and skipped, rows of other code are run again."""
+    partial = tmp_path / 'partial.jsonl'
+    none = blind_family.run_parts([0, 1, 2, 3], 1, 0.0, True, partial=partial,
+                                  one=fake_row, code='A')
+    assert none == [] and not partial.exists()         # no recording started after the time
+    part = blind_family.run_parts([0, 1], 2, float('inf'), True, partial=partial,
+                                  one=fake_row, code='A')
+    assert [r['index'] for r in part] == [0, 1]
+    whole = blind_family.run_parts([0, 1, 2, 3], 2, float('inf'), True, partial=partial,
+                                   one=fake_row, code='A')
+    assert [r['index'] for r in whole] == [0, 1, 2, 3]
+    lines = [json.loads(x) for x in partial.read_text().splitlines()]
+    assert sorted(r['index'] for r in lines) == [0, 1, 2, 3]      # 0 and 1 not run twice
+    assert {r['code'] for r in lines} == {'A'}
+    other = blind_family.run_parts([0, 1], 2, float('inf'), True, partial=partial,
+                                   one=fake_row, code='B')
+    assert [r['index'] for r in other] == [0, 1]
+    assert len(partial.read_text().splitlines()) == 6      # B's rows run again and appended
+    assert sorted(r['index'] for r in blind_family.finished_rows('B', partial)) == [0, 1]
+    assert blind_family.run_parts([5], 1, float('inf'), False, partial=tmp_path / 'no.jsonl',
+                                  one=fake_row, code='B')[0]['index'] == 5
+    assert not (tmp_path / 'no.jsonl').exists()           # keep=False writes nothing
