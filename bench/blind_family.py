@@ -366,7 +366,8 @@ def main() -> int:
                     help='only these recordings (implies --no-write)')
     ap.add_argument('--compare', metavar='OLD_JSON',
                     help='only list the recordings whose findings or final (by more than '
-                         '0.05 x) differ between OLD_JSON and docs/diagnosis_blind.json')
+                         '0.05 x) differ between OLD_JSON and docs/diagnosis_blind.json '
+                         '(or the rows of a run in parts on this code, while there are any)')
     ap.add_argument('--from-json', action='store_true',
                     help='only reprint the tables from docs/diagnosis_blind.json')
     ap.add_argument('--csv', metavar='DIR',
@@ -381,8 +382,13 @@ def main() -> int:
     if args.csv:
         return write_csv(Path(args.csv), args.indices or list(range(args.n)))
     if args.compare:
-        print(moved(json.loads(Path(args.compare).read_text()),
-                    json.loads((ROOT / 'docs' / 'diagnosis_blind.json').read_text())))
+        now = finished_rows(code_hash())
+        if now:
+            print(f'comparing the {len(now)} rows of the run in parts on this code '
+                  f'({PARTIAL.name})')
+        else:
+            now = json.loads((ROOT / 'docs' / 'diagnosis_blind.json').read_text())
+        print(moved(json.loads(Path(args.compare).read_text()), now))
         return 0
     if args.from_json:
         print(summary(json.loads((ROOT / 'docs' / 'diagnosis_blind.json').read_text())))
