@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ['format_diagnosis', 'plot_diagnosis']
+__all__ = ['format_diagnosis', 'plot_diagnosis', 'unknown_reading']
 
 
 def _fmt(x: float) -> str:
@@ -63,6 +63,64 @@ def _params_lines(params: dict) -> list[str]:
     return out
 
 
+def unknown_reading(heldout_x: float, train_x: float, whole_x: float | None,
+                    train_only: list[tuple[str, float]]) -> list[str]:
+    """Sentences that say what an ``unknown`` verdict rests on.
+
+    Parameters
+    ----------
+    heldout_x, train_x : float
+        The final model's held-out and training %e_r, each over its noise floor.
+    whole_x : float or None
+        The chain alone identified on every sample, over the whole record's floor
+        (None when it was not run).
+    train_only : list of (str, float)
+        Blocks whose fit passed on the training part only, with their training %e_r
+        over the training floor.
+
+    Returns
+    -------
+    list of str
+        One sentence per fact, for the report's ``unknown`` verdict.
+    """
+    lines = []
+    if whole_x is not None:
+        if whole_x <= 2.0 and whole_x < 0.5 * heldout_x:
+            lines.append(f'the chain alone, identified on every sample, makes the whole record '
+                         f'at {whole_x:.2f} x its floor against {heldout_x:.2f} x on the '
+                         'held-out part when trained before it: with those samples in its fit '
+                         'the chain makes nearly all of them, so the miss sits after the split')
+        else:
+            lines.append(f'the chain alone, identified on every sample, leaves {whole_x:.2f} x '
+                         'the floor over the whole record: the mismatch is in the data, not '
+                         'only in how the record was split')
+    if train_x <= 1.5 and heldout_x >= 3.0:
+        lines.append(f'the training part is made at {train_x:.2f} x its floor and the held-out '
+                     f'part is missed by {heldout_x:.2f} x: what is missing shows only after '
+                     'the split (a change over time, or conditions the training part barely '
+                     'reached), so this split cannot say which mechanism it is; a record '
+                     'whose training part holds those conditions can')
+    near = [f'{m} ({x:.2f} x)' for m, x in train_only if x <= 1.5]
+    if near:
+        lines.append('blocks that make the training part near its floor but do not carry to '
+                     'the held-out part (training %e_r over its floor): ' + ', '.join(near)
+                     + '; the record supports them only where they were fitted')
+    return lines
+
+
+def _unknown_lines(d: Any) -> list[str]:
+    """:func:`unknown_reading` from a diagnosis."""
+    w = d.extra.get('whole_record')
+    whole = w['er_percent'] / w['noise_floor_percent'] if w else None
+    floor_t = d.noise_floor_train_percent
+    last = d.rounds[-1]['candidates'] if d.rounds else []
+    train_only = [(c['mechanism'], c['er_train_percent'] / floor_t) for c in last
+                  if c['status'] == 'training only']
+    return unknown_reading(d.final.er_holdout_percent / d.noise_floor_percent,
+                           d.final.er_train_percent / floor_t, whole,
+                           sorted(train_only, key=lambda z: z[1]))
+
+
 def format_diagnosis(d: Any) -> str:
     """Plain-text report: where, what physics, fitted block, held-out errors, tests."""
     t = d.t_s
@@ -91,6 +149,7 @@ def format_diagnosis(d: Any) -> str:
             lines.append('verdict: unknown - the model misses something '
                          f'({ratio:.2f} x the noise floor on held-out data) and no mechanism '
                          'of the library explains it (table below); where it shows is above.')
+            lines += [f'  - {x}' for x in _unknown_lines(d)]
         elif 'whole_record' in d.extra:
             ratio = d.final.er_holdout_percent / d.noise_floor_percent
             w = d.extra['whole_record']

@@ -87,6 +87,7 @@ def test_physics_outside_the_library_is_unknown(seed):
     assert whole['er_percent'] > 3.0 * whole['noise_floor_percent']
     assert d.empirical is not None and d.empirical.features == []
     assert 'verdict: unknown' in d.report() and d.to_dict()['empirical']['gain'] < 0.05
+    assert 'the mismatch is in the data, not only in how the record was split' in d.report()
     assert d.status()[0] == 'warn'
 
 
