@@ -269,6 +269,22 @@ def moved(old: list[dict], new: list[dict]) -> str:
     return '\n'.join(lines) or 'nothing moved'
 
 
+def time_ratio(old: list[dict], new: list[dict], indices: list[int] | None = None) -> str:
+    """Median seconds per recording on the recordings both runs have (or ``indices``), a line.
+
+    The same recordings and code paths on two machines: the ratio is the machines', as long
+    as nothing moved (see :func:`moved`).
+    """
+    before = {r['index']: r['seconds'] for r in old}
+    pairs = [(before[r['index']], r['seconds']) for r in new if r['index'] in before
+             and (indices is None or r['index'] in indices)]
+    if not pairs:
+        return 'no recording in both runs'
+    was, now = np.median([p[0] for p in pairs]), np.median([p[1] for p in pairs])
+    return (f'seconds per recording on the same {len(pairs)} recordings, median: '
+            f'{was:.0f} -> {now:.0f} ({now / was:.1f} x)')
+
+
 def write_csv(folder: Path, indices: list[int]) -> int:
     """Write recordings as CSV with their truth beside them (nothing is diagnosed)."""
     folder.mkdir(parents=True, exist_ok=True)
@@ -363,7 +379,8 @@ def main() -> int:
                     help='one recording at a time, its diagnosis in K processes '
                          '(the per-recording time on K cores; --workers is then unused)')
     ap.add_argument('--indices', type=int, nargs='+', metavar='I',
-                    help='only these recordings (implies --no-write)')
+                    help='only these recordings (implies --no-write; with --compare, the '
+                         'recordings its time line covers)')
     ap.add_argument('--compare', metavar='OLD_JSON',
                     help='only list the recordings whose findings or final (by more than '
                          '0.05 x) differ between OLD_JSON and docs/diagnosis_blind.json '
@@ -388,7 +405,9 @@ def main() -> int:
                   f'({PARTIAL.name})')
         else:
             now = json.loads((ROOT / 'docs' / 'diagnosis_blind.json').read_text())
-        print(moved(json.loads(Path(args.compare).read_text()), now))
+        before = json.loads(Path(args.compare).read_text())
+        print(moved(before, now))
+        print(time_ratio(before, now, args.indices))
         return 0
     if args.from_json:
         print(summary(json.loads((ROOT / 'docs' / 'diagnosis_blind.json').read_text())))
