@@ -63,6 +63,15 @@ def _params_lines(params: dict) -> list[str]:
     return out
 
 
+#: ``unknown_reading``: within this multiple of its floor a part counts as made (the same
+#: multiple as ``driver.UNKNOWN_FACTOR``, above which a held-out miss is a finding), ...
+NEAR_FLOOR = 1.5
+#: ... a held-out miss this many times the floor is far beyond it, ...
+FAR_FROM_FLOOR = 3.0
+#: ... and a whole-record fit within this multiple is close to it.
+WHOLE_RECORD_CLOSE = 2.0
+
+
 def unknown_reading(heldout_x: float, train_x: float, whole_x: float | None,
                     train_only: list[tuple[str, float]]) -> list[str]:
     """Sentences that say what an ``unknown`` verdict rests on.
@@ -85,7 +94,7 @@ def unknown_reading(heldout_x: float, train_x: float, whole_x: float | None,
     """
     lines = []
     if whole_x is not None:
-        if whole_x <= 2.0 and whole_x < 0.5 * heldout_x:
+        if whole_x <= WHOLE_RECORD_CLOSE and whole_x < 0.5 * heldout_x:
             lines.append(f'the chain alone, identified on every sample, makes the whole record '
                          f'at {whole_x:.2f} x its floor against {heldout_x:.2f} x on the '
                          'held-out part when trained before it: with those samples in its fit '
@@ -94,13 +103,13 @@ def unknown_reading(heldout_x: float, train_x: float, whole_x: float | None,
             lines.append(f'the chain alone, identified on every sample, leaves {whole_x:.2f} x '
                          'the floor over the whole record: the mismatch is in the data, not '
                          'only in how the record was split')
-    if train_x <= 1.5 and heldout_x >= 3.0:
+    if train_x <= NEAR_FLOOR and heldout_x >= FAR_FROM_FLOOR:
         lines.append(f'the training part is made at {train_x:.2f} x its floor and the held-out '
                      f'part is missed by {heldout_x:.2f} x: what is missing shows only after '
                      'the split (a change over time, or conditions the training part barely '
                      'reached), so this split cannot say which mechanism it is; a record '
                      'whose training part holds those conditions can')
-    near = [f'{m} ({x:.2f} x)' for m, x in train_only if x <= 1.5]
+    near = [f'{m} ({x:.2f} x)' for m, x in train_only if x <= NEAR_FLOOR]
     if near:
         lines.append('blocks that make the training part near its floor but do not carry to '
                      'the held-out part (training %e_r over its floor): ' + ', '.join(near)

@@ -43,6 +43,13 @@ def test_a_miss_the_whole_record_shares_is_in_the_data():
     assert 'creep (0.98 x), sensor_lag (0.98 x)' in text and 'gain_drift' not in text
 
 
+def test_a_whole_record_fit_as_far_off_as_the_held_out_part_is_in_the_data():
+    """Near the floor over the whole record, but no nearer than held out: not the split's doing."""
+    text = ' '.join(unknown_reading(2.0, 1.1, 1.8, []))
+    assert 'leaves 1.80 x the floor over the whole record' in text
+    assert 'the miss sits after the split' not in text
+
+
 def test_without_a_whole_record_fit_or_candidates_only_the_split_is_read():
     """A held-out miss near the floor in training: the split sentence alone."""
     assert len(unknown_reading(4.0, 1.1, None, [])) == 1
