@@ -154,14 +154,38 @@ def _module_fixture_user(item: pytest.Item) -> bool:
                for name, defs in info.name2fixturedefs.items() if name in item.fixturenames)
 
 
+def pytest_addoption(parser):
+    """``--thorough``: also run the tests marked ``thorough`` (``./run test-all``)."""
+    parser.addoption('--thorough', action='store_true', default=False,
+                     help='also run the thorough tier: further seeds of tests that one '
+                          'seed already checks, stress counts (./run test-all; '
+                          'HYST_ID_THOROUGH=1 does the same)')
+
+
+def thorough_requested(config) -> bool:
+    """Whether this run includes the thorough tier."""
+    return bool(config.getoption('--thorough')
+                or os.environ.get('HYST_ID_THOROUGH', '') not in ('', '0'))
+
+
+#: Why a thorough test is skipped by ``./run test`` (what CI runs).
+THOROUGH_SKIP = ('thorough tier (further seeds or a stress count of a check that runs '
+                 'here once): ./run test-all runs it')
+
+
 @pytest.hookimpl(tryfirst=True)
 def pytest_collection_modifyitems(config, items):
     """Group the tests for two workers (``./run test``: ``--dist loadgroup``).
 
     The tests of a module that share a module-scoped fixture go to one
     worker together (an ``xdist_group``), so the fixture is computed once,
-    not once per worker. The order is left as collected.
+    not once per worker. The order is left as collected. Tests marked
+    ``thorough`` are skipped, with the reason shown, unless the run asks
+    for them (``--thorough``).
     """
+    skip = None if thorough_requested(config) else pytest.mark.skip(reason=THOROUGH_SKIP)
     for item in items:
         if _module_fixture_user(item) and item.get_closest_marker('xdist_group') is None:
             item.add_marker(pytest.mark.xdist_group(name=item.nodeid.split('::')[0]))
+        if skip is not None and item.get_closest_marker('thorough') is not None:
+            item.add_marker(skip)

@@ -58,7 +58,7 @@ def _judged_ratio(d) -> float:
     return j['final_er_percent'] / j['noise_floor_percent']
 
 
-@pytest.mark.parametrize('seed', [0, 3])
+@pytest.mark.parametrize('seed', [0, pytest.param(3, marks=pytest.mark.thorough)])
 def test_a_ringing_actuator_is_named_with_its_dynamics(seed):
     """Named, with its damping and frequency, in the reference's hold convention, at the floor.
 
@@ -80,7 +80,7 @@ def test_a_ringing_actuator_is_named_with_its_dynamics(seed):
     assert f.er_holdout_after_percent < 0.5 * f.er_holdout_before_percent
 
 
-@pytest.mark.parametrize('seed', [3, 7])
+@pytest.mark.parametrize('seed', [3, pytest.param(7, marks=pytest.mark.thorough)])
 def test_a_first_order_lag_stays_sensor_lag(seed):
     """A 0.4 s lag is ``sensor_lag`` with its time constant, where the held-out part extrapolates.
 

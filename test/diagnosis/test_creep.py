@@ -48,7 +48,7 @@ def _recording(seed: int, share: float, tau_s: float = 12.0) -> Recording:
                      'um', f'creep #{seed}')
 
 
-@pytest.mark.parametrize('seed', [0, 1])
+@pytest.mark.parametrize('seed', [0, pytest.param(1, marks=pytest.mark.thorough)])
 def test_a_slow_share_of_the_travel_is_creep(seed):
     """Named with its time constant and share, and the held-out error at the floor.
 

@@ -133,7 +133,7 @@ def test_each_mechanism_is_named(mech):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize('seed', range(2))
+@pytest.mark.parametrize('seed', [0, pytest.param(1, marks=pytest.mark.thorough)])
 def test_curved_branches_are_named_loop_shape(seed):
     """A smooth (Prandtl-Ishlinskii) loop is a loop shape, not a block after the paper's loop."""
     rec, _ = smooth_recording(seed)
@@ -196,6 +196,7 @@ def check_stick_slip(d, band: float) -> None:
 
 
 @pytest.mark.slow
+@pytest.mark.thorough
 def test_stick_slip_is_lined_up_on_held_out_data_often(record_property):
     """Six noise seeds: every one named and improved, a share at the floor.
 
@@ -205,8 +206,8 @@ def test_stick_slip_is_lined_up_on_held_out_data_often(record_property):
     seeds 5..16 x {unperturbed, round-off probe} (``bench/claim_spreads.py
     --only stiction --seeds 12``): named 24/24, held-out gain 23.6 % to
     80.5 %, final/floor 0.93 to 3.66 with 14 of 24 under 1.5 (5 to 9 of 12
-    per run, CI on another CPU make: 5). Seeds 5..10 alone (this test, six
-    to keep CI short; the twelve stay in the benchmark): final/floor 3.15,
+    per run, CI on another CPU make: 5). Seeds 5..10 alone (this test, in
+    the thorough tier; the twelve stay in the benchmark): final/floor 3.15,
     0.96, 1.48, 0.94, 0.97, 1.80, gain 23.4 % to 79.8 %, 3 to 4 under 1.5
     (seed 7 sits on the line). Bounds outside that spread: 2 of 6 at the
     floor, every one improved by at least 15 % and within 4.5 x the floor.

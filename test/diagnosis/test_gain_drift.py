@@ -49,7 +49,7 @@ def _recording(seed: int, gain_of_t, channel: str = 'position') -> Recording:
                      'um', f'gain drift #{seed}')
 
 
-@pytest.mark.parametrize('seed', [0, 1])
+@pytest.mark.parametrize('seed', [0, pytest.param(1, marks=pytest.mark.thorough)])
 def test_a_growing_gain_is_gain_drift(seed):
     d = diagnose(_recording(seed, lambda t: 1.0 + 0.0008 * t), settings=SETTINGS)
     assert d.verdict == 'gain_drift', [f.mechanism for f in d.findings]

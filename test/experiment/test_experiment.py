@@ -220,6 +220,7 @@ def test_cli_gaass_only_quick(tmp_path, capsys):
 
 
 @pytest.mark.slow
+@pytest.mark.thorough
 def test_paper_settings_beat_all_six_paper_numbers():
     """Ten seeds, 500 generations, N_pop 10 (the paper's settings), regulation off.
 

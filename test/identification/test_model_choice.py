@@ -55,7 +55,7 @@ def _tk_recording(seed: int) -> Recording:
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize('seed', range(2))
+@pytest.mark.parametrize('seed', [0, pytest.param(1, marks=pytest.mark.thorough)])
 def test_a_curved_loop_goes_to_the_smooth_family(seed):
     rec, _ = smooth_recording(seed)
     choice = choose_family(rec, settings=SETTINGS)
@@ -66,7 +66,7 @@ def test_a_curved_loop_goes_to_the_smooth_family(seed):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize('seed', range(2))
+@pytest.mark.parametrize('seed', [0, pytest.param(1, marks=pytest.mark.thorough)])
 def test_a_piecewise_linear_loop_stays_with_tk(seed):
     choice = choose_family(_tk_recording(seed), settings=SETTINGS)
     scores = {s.family: s.holdout_er_percent for s in choice.scores}

@@ -136,7 +136,8 @@ def test_compensator_runs_the_smooth_inverse_in_line():
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize('seed', range(3))
+@pytest.mark.parametrize('seed', [0] + [pytest.param(s, marks=pytest.mark.thorough)
+                                        for s in (1, 2)])
 def test_identify_reaches_the_true_floor_on_smooth_loops(seed):
     rec, floor = smooth_recording(seed)
     spec = domains_from_data(rec, family='smooth')

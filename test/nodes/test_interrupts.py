@@ -20,8 +20,8 @@ load in CI), and a node without timers could miss it. Each executable is
 interrupted at delays from its first log line (the node is built) into its
 first spins. A Ctrl-C during Python's own imports, before ``main()`` runs,
 is Python's KeyboardInterrupt and is not covered. Worker processes of an
-identification end with a cancel and die with their parent. The slow test
-repeats the stops 20 times per executable and counts hangs and orphans
+identification end with a cancel and die with their parent. The thorough-tier
+test repeats the stops 20 times per executable and counts hangs and orphans
 (``bench/stop_stress.py`` prints the same counts and stop times).
 """
 
@@ -102,6 +102,7 @@ def test_stops_are_clean(node, ros_domain, tmp_path):
 
 
 @pytest.mark.slow
+@pytest.mark.thorough
 @pytest.mark.parametrize('node', NODES)
 def test_twenty_stops_no_hang_no_orphan(node, ros_domain, tmp_path):
     """Issue 15's count: 20 starts and stops per executable, Ctrl-C and SIGTERM in turn.
