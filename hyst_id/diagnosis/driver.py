@@ -55,7 +55,7 @@ from hyst_id.diagnosis.baseline import baseline_starts, whole_record_er
 from hyst_id.diagnosis.control import drop_superseded, equivalent_chain, null_control
 from hyst_id.diagnosis.control import recheck
 from hyst_id.diagnosis.empirical import empirical_block
-from hyst_id.diagnosis.locate import Localization, locate, noise_std
+from hyst_id.diagnosis.locate import LEVEL_TREND_T, Localization, locate, noise_std
 from hyst_id.diagnosis.mechanisms import get_mechanisms
 from hyst_id.diagnosis.mechanisms.base import Context, Mechanism
 from hyst_id.diagnosis.model import ComposedModel
@@ -79,8 +79,8 @@ from hyst_id.signals.noise import floor_percent
 from hyst_id.signals.reversals import period_s
 from hyst_id.signals.split import inside_rows, split_index
 
-__all__ = ['UNKNOWN_FACTOR', 'WHOLE_RECORD_FACTOR', 'diagnose', 'finding_from', 'located_where',
-           'range_note']
+__all__ = ['UNKNOWN_FACTOR', 'WHOLE_RECORD_FACTOR', 'diagnose', 'finding_from', 'gain_call',
+           'located_where', 'range_note']
 
 #: Held-out %e_r over the noise floor above which what is left counts as missing physics.
 UNKNOWN_FACTOR = 1.5
@@ -308,6 +308,7 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
             loc = locate(t, v_orig, y, current.prediction, sigma, n_train, ctx.period_s)
     _final_corrections(findings, mechs, current, ctx, v_orig)
     final_loc = loc if current is not baseline else loc0
+    gain_call(findings, final_loc, {m.id for m in mechs})
     empirical = None
     if current.er_holdout_percent > UNKNOWN_FACTOR * floor_h:
         say('empirical block: what a model could still gain')
@@ -338,6 +339,35 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
                                          'hold': current.model.hold
                                          if current.model.dynamic else '',
                                          'judged_holdout': _judged(data, baseline, current)})
+
+
+def gain_call(findings: list[Finding], final_loc: Localization, library: set[str]) -> None:
+    """Name a changing gain as a judgement call where an offset drift took its place.
+
+    A gain that changes about a zero far from the travel is mostly an offset
+    ramp: ``offset_drift`` can win its round, and the re-identified chain then
+    reaches the floor, while the final residual's trend still scales with the
+    output level (:data:`~hyst_id.diagnosis.locate.LEVEL_TREND_T`). On the blind
+    family's #64 (a 2.9 % gain growth about a zero five spans below the
+    travel) the time-gain block's own fit stopped at the slowest rate of its
+    search around the first chain, ``offset_drift`` took the round and ended
+    at 1.03 x the floor with the level term at t = 7.2. Whether a gain or an
+    offset drifts is then a judgement call, and the offset finding says so:
+    a growing trend names ``gain_drift``, a falling one ``supply_decay``
+    (where the channel's library has it). Nothing changes when a time-gain
+    block is already a finding.
+    """
+    ids = {f.mechanism for f in findings}
+    level_t = float(final_loc.trend['level_t'])
+    if 'offset_drift' not in ids or abs(level_t) <= LEVEL_TREND_T:
+        return
+    gain = 'gain_drift' if level_t > 0 else 'supply_decay'
+    if gain not in library or ids & {'gain_drift', 'supply_decay'}:
+        return
+    f = next(f for f in findings if f.mechanism == 'offset_drift')
+    f.alternatives = list(f.alternatives) + [{
+        'mechanism': gain, 'kind': 'signature', 'level_t': level_t,
+        'er_holdout_after_percent': f.er_holdout_after_percent}]
 
 
 def _rechosen_note(before: FitResult, after: FitResult, data: Data) -> str:

@@ -45,10 +45,13 @@ from scipy import stats
 from hyst_id.signals.noise import robust_noise_std as noise_std
 from hyst_id.signals.reversals import reversal_times
 
-__all__ = ['Localization', 'locate', 'newey_west_t', 'noise_std']
+__all__ = ['LEVEL_TREND_T', 'Localization', 'locate', 'newey_west_t', 'noise_std']
 
 Z99 = 2.5758   # two-sided 99 % normal quantile
 Z_FAMILY = 3.29  # two-sided 99.9 %: bound for the largest of many correlation lags
+#: |t| of the time x level term above which the residual's trend scales with the output
+#: level (a gain that changes with time, not an offset)
+LEVEL_TREND_T = 4.0
 
 
 @dataclass
@@ -103,7 +106,7 @@ class Localization:
             out.append(f'trend over time: {tr["slope_per_s"]:+.3g}{u}/s (t={tr["t"]:.1f}); '
                        f'held-out mean {tr["holdout_mean"]:+.3g}{u} vs training '
                        f'{tr["train_mean"]:+.3g}{u}')
-        if abs(tr['level_t']) > 4:
+        if abs(tr['level_t']) > LEVEL_TREND_T:
             out.append(f'the trend scales with the output level (t={tr["level_t"]:.1f}): a '
                        'gain that changes with time')
         bad = [w for w in self.windows if w['flagged']]

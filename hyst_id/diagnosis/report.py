@@ -52,6 +52,14 @@ def _alternative_lines(f: Any) -> list[str]:
                      f'(held-out {_fmt(f.er_holdout_after_percent)} for {f.mechanism}); '
                      'round-off, the split or a slightly different record could reverse '
                      'the order')
+    for a in f.alternatives:
+        if a.get('kind') == 'signature':
+            way = 'growing' if a['mechanism'] == 'gain_drift' else 'falling'
+            lines.append(f'    a judgement call: the residual left at the end still trends in '
+                         f'proportion to the output level (t={a["level_t"]:.1f}): the '
+                         f'sensitivity may be {way} ({a["mechanism"]}) rather than the offset '
+                         'drifting; about a zero far from the travel a gain drift looks like '
+                         'an offset drift, and the data do not separate the two at this size')
     return lines
 
 
