@@ -167,7 +167,7 @@ def run(index: int, workers: int = 1) -> dict:
     out.update(verdict=d.verdict, found=[f.mechanism for f in d.findings],
                # per finding, the tied candidates and close calls its report names
                calls=[[a['mechanism'] for a in f.alternatives
-                       if a.get('kind', 'tied') in ('tied', 'close', 'signature')]
+                       if a.get('kind', 'tied') in ('tied', 'close', 'signature', 'hold')]
                       for f in d.findings],
                cost=j['baseline_er_percent'] / j['noise_floor_percent'],
                final=j['final_er_percent'] / j['noise_floor_percent'],

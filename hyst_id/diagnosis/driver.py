@@ -69,6 +69,7 @@ from hyst_id.diagnosis.select import (
     Data,
     evaluate,
     FitResult,
+    hold_calls,
     round_record,
 )
 from hyst_id.diagnosis.trial import polish_all, try_all
@@ -273,6 +274,7 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
         mech = next(m for m in mechs if m.id == winner.mechanism)
         alternatives = alternatives_record(
             tied, close_calls(comps, winner, tied, data, settings.criteria), data)
+        alternatives += hold_calls(winner, comps, data, settings.criteria)
         first, trained = winner, winner.fit.er_train_percent
         winner, contested = contest(winner, comps, data, ctx, spec, settings,
                                     floor_train_percent=floor_t,

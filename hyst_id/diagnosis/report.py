@@ -53,6 +53,12 @@ def _alternative_lines(f: Any) -> list[str]:
                      'round-off, the split or a slightly different record could reverse '
                      'the order')
     for a in f.alternatives:
+        if a.get('kind') == 'hold':
+            lines.append(f'    a judgement call: {a["mechanism"]} behind a one-sample hold (the '
+                         'sample read before the new command acts) predicts the held-out part '
+                         f'about as well (held-out {_fmt(a["er_holdout_after_percent"])}): a '
+                         'lag of about a sample period and a delay of a sample or two look '
+                         'alike at this sample rate')
         if a.get('kind') == 'signature':
             way = 'growing' if a['mechanism'] == 'gain_drift' else 'falling'
             lines.append(f'    a judgement call: the residual left at the end still trends in '

@@ -62,6 +62,7 @@ from hyst_id.identification.chains import er_percent
 
 __all__ = ['Criteria', 'Data', 'FitResult', 'Comparison', 'evaluate', 'fit_model', 'polish',
            'compare', 'choose', 'close_calls', 'alternatives_record', 'explained_share',
+           'hold_calls',
            'improvement_z', 'passes_holdout', 'round_record']
 
 
@@ -163,6 +164,9 @@ class Comparison:
     share: float = 0.0
     evidence: float = 0.0
     where: dict = field(default_factory=dict)
+    #: a filter block's fit in the ``after`` hold that was dropped as a one-sample delay
+    #: in disguise (:func:`hyst_id.diagnosis.trial.try_mechanism`), kept for the report
+    screened: FitResult | None = None
 
 
 def evaluate(model: ComposedModel, data: Data, p: np.ndarray, nfev: int = 0) -> FitResult:
@@ -429,6 +433,36 @@ def close_calls(comparisons: list[Comparison], winner: Comparison | None,
     return [c for c in comparisons if c.accepted and c is not winner
             and all(c is not t for t in tied)
             and data.judged_er_percent(c.fit) <= criteria.judgement_ratio * best]
+
+
+def hold_calls(winner: Comparison, comps: list[Comparison], data: Data,
+               criteria: Criteria) -> list[dict]:
+    """Filters behind a one-sample hold that a winning dead time stands for as well.
+
+    On a static chain a filter block fitted in the ``after`` hold is dropped
+    when it changes its input less than the hold's one-sample shift does
+    (:func:`hyst_id.diagnosis.trial.try_mechanism`): it is mostly a delay.
+    But a first-order lag of about a sample behind such a hold (the reference
+    simulator's convention, a rig sampled before the new command acts) is also
+    mostly a delay: on the blind family's #84 (a 1.4-sample lag) ``dead_time``
+    won with 1.9 samples, and on #134 (0.5 samples) with 1.2. When the winner is
+    ``dead_time`` and such a dropped fit predicts the judged held-out samples
+    within ``criteria.judgement_ratio`` of it, the report names it (``kind``
+    ``hold``).
+    """
+    if winner.mechanism != 'dead_time':
+        return []
+    best = data.judged_er_percent(winner.fit)
+    out = []
+    for c in comps:
+        if c.screened is None:
+            continue
+        er = data.judged_er_percent(c.screened)
+        if er <= criteria.judgement_ratio * best:
+            out.append({'mechanism': c.mechanism, 'kind': 'hold',
+                        'er_holdout_after_percent': c.screened.er_holdout_percent,
+                        'er_judged_after_percent': er})
+    return out
 
 
 def alternatives_record(tied: list[Comparison], close: list[Comparison],

@@ -124,6 +124,7 @@ def try_mechanism(m: Mechanism, current: FitResult, data: Data, ctx: Context,
     """Fit ``m`` into ``current`` and judge it (the criteria, its evidence, its plausibility)."""
     prev = current.model
     thetas = {pm.id: prev.theta(current.p, pm.id) for pm in prev.mechanisms}
+    screened = None
     if getattr(m, 'swap_family', ''):
         fit = _swap_family(m, current, data, ctx, settings, thetas)
     else:
@@ -139,10 +140,12 @@ def try_mechanism(m: Mechanism, current: FitResult, data: Data, ctx: Context,
             got = fit_model(model, data, p_prev, m, budget=settings.fit_budget,
                             chain_starts=[c for c in chain_starts if c.size == prev.n_chain])
             if len(holds) > 1 and hold == 'after' and not _filter_beats_shift(got, m, data):
-                continue        # a one-sample delay in disguise: dead_time's business
+                screened = got  # a one-sample delay in disguise: dead_time's business
+                continue
             if fit is None or got.sse_train < fit.sse_train:
                 fit = got
     comp = compare(current, fit, data, m.id, settings.criteria)
+    comp.screened = screened
     comp.evidence, comp.where = m.evidence(loc)
     model = fit.model
     theta = model.theta(fit.p, m.id) if m.id in model.slices else np.zeros(0)
