@@ -62,7 +62,7 @@ from hyst_id.identification.chains import er_percent
 
 __all__ = ['Criteria', 'Data', 'FitResult', 'Comparison', 'evaluate', 'fit_model', 'polish',
            'compare', 'choose', 'close_calls', 'alternatives_record', 'explained_share',
-           'hold_calls',
+           'HOLD_CALL_SAMPLES', 'hold_calls',
            'improvement_z', 'passes_holdout', 'round_record']
 
 
@@ -435,6 +435,11 @@ def close_calls(comparisons: list[Comparison], winner: Comparison | None,
             and data.judged_er_percent(c.fit) <= criteria.judgement_ratio * best]
 
 
+#: :func:`hold_calls` only for a dead time up to this many sample periods (a hold's one
+#: sample plus a lag of about one)
+HOLD_CALL_SAMPLES = 3.0
+
+
 def hold_calls(winner: Comparison, comps: list[Comparison], data: Data,
                criteria: Criteria) -> list[dict]:
     """Filters behind a one-sample hold that a winning dead time stands for as well.
@@ -448,9 +453,14 @@ def hold_calls(winner: Comparison, comps: list[Comparison], data: Data,
     won with 1.9 samples, and on #134 (0.5 samples) with 1.2. When the winner is
     ``dead_time`` and such a dropped fit predicts the judged held-out samples
     within ``criteria.judgement_ratio`` of it, the report names it (``kind``
-    ``hold``).
+    ``hold``). Only for delays up to :data:`HOLD_CALL_SAMPLES` sample periods:
+    a longer delay is not what a sub-sample lag behind a hold looks like.
     """
     if winner.mechanism != 'dead_time':
+        return []
+    model = winner.fit.model
+    dt_s = float(np.median(np.diff(data.t_s)))
+    if model is None or model.theta(winner.fit.p, 'dead_time')[0] > HOLD_CALL_SAMPLES * dt_s:
         return []
     best = data.judged_er_percent(winner.fit)
     out = []

@@ -24,19 +24,23 @@ from __future__ import annotations
 
 from types import SimpleNamespace
 
+import numpy as np
+
 from hyst_id.diagnosis.report import _alternative_lines
 from hyst_id.diagnosis.result import Finding
-from hyst_id.diagnosis.select import Criteria, hold_calls
+from hyst_id.diagnosis.select import Criteria, HOLD_CALL_SAMPLES, hold_calls
 
-DATA = SimpleNamespace(judged_er_percent=lambda fit: fit.er)
-
-
-def _fit(er: float):
-    return SimpleNamespace(er=er, er_holdout_percent=er)
+DT_S = 0.1
+DATA = SimpleNamespace(judged_er_percent=lambda fit: fit.er, t_s=np.arange(2000) * DT_S)
 
 
-def _comp(mechanism: str, er: float, screened: float | None = None):
-    return SimpleNamespace(mechanism=mechanism, fit=_fit(er),
+def _fit(er: float, delay_s: float = 0.0):
+    model = SimpleNamespace(theta=lambda p, mechanism: np.array([delay_s]))
+    return SimpleNamespace(er=er, er_holdout_percent=er, model=model, p=None)
+
+
+def _comp(mechanism: str, er: float, screened: float | None = None, delay_s: float = 0.115):
+    return SimpleNamespace(mechanism=mechanism, fit=_fit(er, delay_s),
                            screened=None if screened is None else _fit(screened))
 
 
@@ -62,3 +66,11 @@ def test_a_dropped_fit_beyond_the_judgement_ratio_or_another_winner_adds_nothing
     other = _comp('creep', 0.3918)
     assert hold_calls(other, [other, _comp('sensor_lag', 0.5, screened=0.39)],
                       DATA, Criteria()) == []
+
+
+def test_a_delay_of_many_samples_is_not_a_lag_behind_a_hold():
+    lag = _comp('sensor_lag', 0.5947, screened=0.3904)
+    for delay_s, called in ((HOLD_CALL_SAMPLES * DT_S * 0.99, True),
+                            (HOLD_CALL_SAMPLES * DT_S * 1.01, False), (3.4, False)):
+        winner = _comp('dead_time', 0.3918, delay_s=delay_s)
+        assert bool(hold_calls(winner, [winner, lag], DATA, Criteria())) is called, delay_s
