@@ -90,7 +90,8 @@ def test_blind_134_states_the_sensor_lag_it_holds():
     """#134 (a sub-sample lag in the reference's hold): a finding or a stated judgement call.
 
     Which of the two is the verdict may turn on round-off; that the report names
-    sensor_lag one way or the other may not.
+    sensor_lag one way or the other may not (it held unperturbed and under
+    ``HYST_ID_ROUNDOFF_PROBE=1`` and ``=2`` on 2026-11-28).
     """
     case = blind_family.draw(134)
     assert case['effects'] == ['sensor_lag']
