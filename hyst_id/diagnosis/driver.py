@@ -274,7 +274,9 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
         mech = next(m for m in mechs if m.id == winner.mechanism)
         alternatives = alternatives_record(
             tied, close_calls(comps, winner, tied, data, settings.criteria), data)
-        alternatives += hold_calls(winner, comps, data, settings.criteria)
+        named = {a['mechanism'] for a in alternatives}
+        alternatives += [a for a in hold_calls(winner, comps, data, settings.criteria)
+                         if a['mechanism'] not in named]
         first, trained = winner, winner.fit.er_train_percent
         winner, contested = contest(winner, comps, data, ctx, spec, settings,
                                     floor_train_percent=floor_t,

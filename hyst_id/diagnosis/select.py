@@ -449,8 +449,9 @@ def hold_calls(winner: Comparison, comps: list[Comparison], data: Data,
     (:func:`hyst_id.diagnosis.trial.try_mechanism`): it is mostly a delay.
     But a first-order lag of about a sample behind such a hold (the reference
     simulator's convention, a rig sampled before the new command acts) is also
-    mostly a delay: on the blind family's #84 (a 1.4-sample lag) ``dead_time``
-    won with 1.9 samples, and on #134 (0.5 samples) with 1.2. When the winner is
+    mostly a delay: on the blind family's #134 (a 0.5-sample lag) ``dead_time``
+    won with 1.2 samples and the dropped lag fit was as good on held-out data
+    (on #84, a 1.4-sample lag, it was not: fitted around a biased chain). When the winner is
     ``dead_time`` and such a dropped fit predicts the judged held-out samples
     within ``criteria.judgement_ratio`` of it, the report names it (``kind``
     ``hold``). Only for delays up to :data:`HOLD_CALL_SAMPLES` sample periods:
