@@ -275,8 +275,8 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
         alternatives = alternatives_record(
             tied, close_calls(comps, winner, tied, data, settings.criteria), data)
         named = {a['mechanism'] for a in alternatives}
-        alternatives += [a for a in hold_calls(winner, comps, data, settings.criteria)
-                         if a['mechanism'] not in named]
+        calls = hold_calls(winner, comps, data, settings.criteria, ctx.dt_s)
+        alternatives += [a for a in calls if a['mechanism'] not in named]
         first, trained = winner, winner.fit.er_train_percent
         winner, contested = contest(winner, comps, data, ctx, spec, settings,
                                     floor_train_percent=floor_t,
@@ -359,7 +359,8 @@ def gain_call(findings: list[Finding], final_loc: Localization, library: set[str
     offset drifts is then a judgement call, and the offset finding says so:
     a growing trend names ``gain_drift``, a falling one ``supply_decay``
     (where the channel's library has it). Nothing changes when a time-gain
-    block is already a finding.
+    block is already a finding or the gain already one of the finding's
+    alternatives.
     """
     ids = {f.mechanism for f in findings}
     level_t = float(final_loc.trend['level_t'])
@@ -369,6 +370,8 @@ def gain_call(findings: list[Finding], final_loc: Localization, library: set[str
     if gain not in library or ids & {'gain_drift', 'supply_decay'}:
         return
     f = next(f for f in findings if f.mechanism == 'offset_drift')
+    if gain in {a['mechanism'] for a in f.alternatives}:
+        return      # already named as tied or close (as under round-off probes 1 and 2 on #64)
     f.alternatives = list(f.alternatives) + [{
         'mechanism': gain, 'kind': 'signature', 'level_t': level_t,
         'er_holdout_after_percent': f.er_holdout_after_percent}]

@@ -77,3 +77,11 @@ def test_only_an_offset_finding_without_a_time_gain_block_gets_the_call(ids):
     findings = [_finding(m) for m in ids]
     gain_call(findings, _loc(9.0), LIBRARY)
     assert all(f.alternatives == [] for f in findings)
+
+
+def test_a_gain_already_named_as_a_close_call_is_not_named_twice():
+    findings = [_finding('offset_drift')]
+    findings[0].alternatives = [{'mechanism': 'gain_drift', 'kind': 'close',
+                                 'er_holdout_after_percent': 0.083}]
+    gain_call(findings, _loc(7.2), LIBRARY)
+    assert [a['kind'] for a in findings[0].alternatives] == ['close']
