@@ -169,6 +169,8 @@ def run(index: int, workers: int = 1) -> dict:
                calls=[[a['mechanism'] for a in f.alternatives
                        if a.get('kind', 'tied') in ('tied', 'close', 'signature', 'hold')]
                       for f in d.findings],
+               # the final residual's time x level t (driver.gain_call's signature)
+               level_t=d.final_localization.trend['level_t'],
                cost=j['baseline_er_percent'] / j['noise_floor_percent'],
                final=j['final_er_percent'] / j['noise_floor_percent'],
                seconds=time.time() - t0)
@@ -367,7 +369,9 @@ def _say(r: dict, k: int, n: int, t0: float) -> None:
           f'{r["channel"]} {r["excitation"]} {1 / r["dt_s"]:g} Hz '
           f'{"+".join(r["effects"]) or "clean"} (cost {r["cost"]:.1f} x) -> '
           f'{"+".join(r["found"]) or r["verdict"]} (final {r["final"]:.2f} x, '
-          f'{r["seconds"]:.0f} s)', flush=True)
+          f'{r["seconds"]:.0f} s)'
+          + (f'; calls: {_calls(r)}' if _calls(r) else '')
+          + (f'; final level t {r["level_t"]:.1f}' if 'level_t' in r else ''), flush=True)
 
 
 def main() -> int:

@@ -435,13 +435,14 @@ def close_calls(comparisons: list[Comparison], winner: Comparison | None,
             and data.judged_er_percent(c.fit) <= criteria.judgement_ratio * best]
 
 
-#: :func:`hold_calls` only for a dead time up to this many sample periods (a hold's one
-#: sample plus a lag of about one)
+#: :func:`hold_calls` only for a dead time up to this many sample periods: the screen
+#: drops ``after``-hold lags below about 1.44 samples (``a > 0.5``), so such a lag and its
+#: hold delay the reading by at most about 2.4 samples on average; 3 leaves a margin
 HOLD_CALL_SAMPLES = 3.0
 
 
 def hold_calls(winner: Comparison, comps: list[Comparison], data: Data,
-               criteria: Criteria) -> list[dict]:
+               criteria: Criteria, dt_s: float) -> list[dict]:
     """Filters behind a one-sample hold that a winning dead time stands for as well.
 
     On a static chain a filter block fitted in the ``after`` hold is dropped
@@ -455,12 +456,12 @@ def hold_calls(winner: Comparison, comps: list[Comparison], data: Data,
     ``dead_time`` and such a dropped fit predicts the judged held-out samples
     within ``criteria.judgement_ratio`` of it, the report names it (``kind``
     ``hold``). Only for delays up to :data:`HOLD_CALL_SAMPLES` sample periods:
-    a longer delay is not what a sub-sample lag behind a hold looks like.
+    a longer delay is not what a sub-sample lag behind a hold looks like
+    (``dt_s``: the sample period, :attr:`~hyst_id.diagnosis.mechanisms.base.Context.dt_s`).
     """
     if winner.mechanism != 'dead_time':
         return []
     model = winner.fit.model
-    dt_s = float(np.median(np.diff(data.t_s)))
     if model is None or model.theta(winner.fit.p, 'dead_time')[0] > HOLD_CALL_SAMPLES * dt_s:
         return []
     best = data.judged_er_percent(winner.fit)
@@ -498,5 +499,8 @@ def round_record(round_no: int, comps: list[Comparison], winner: Comparison | No
          'er_judged_percent': data.judged_er_percent(c.fit) if data is not None
          else c.fit.er_holdout_percent, 'delta_bic': c.delta_bic,
          'holdout_z': c.holdout_z, 'holdout_gain': c.gain, 'explained_share': c.share,
-         'evidence': c.evidence}
+         'evidence': c.evidence,
+         # the after-hold fit the screen dropped (hold_calls), when there was one
+         'er_judged_screened_percent': None if c.screened is None or data is None
+         else data.judged_er_percent(c.screened)}
         for c in comps]}

@@ -31,7 +31,7 @@ from hyst_id.diagnosis.result import Finding
 from hyst_id.diagnosis.select import Criteria, HOLD_CALL_SAMPLES, hold_calls
 
 DT_S = 0.1
-DATA = SimpleNamespace(judged_er_percent=lambda fit: fit.er, t_s=np.arange(2000) * DT_S)
+DATA = SimpleNamespace(judged_er_percent=lambda fit: fit.er)
 
 
 def _fit(er: float, delay_s: float = 0.0):
@@ -47,7 +47,7 @@ def _comp(mechanism: str, er: float, screened: float | None = None, delay_s: flo
 def test_a_dropped_lag_as_good_as_the_winning_dead_time_is_a_judgement_call():
     winner = _comp('dead_time', 0.3918)
     comps = [winner, _comp('sensor_lag', 0.5947, screened=0.3904), _comp('creep', 1.9)]
-    (call,) = hold_calls(winner, comps, DATA, Criteria())
+    (call,) = hold_calls(winner, comps, DATA, Criteria(), DT_S)
     assert call['mechanism'] == 'sensor_lag' and call['kind'] == 'hold'
     assert call['er_judged_after_percent'] == 0.3904
     f = Finding('dead_time', '', '', '', {}, {}, 1.35, 0.40, 2.02, 0.3918, -3421.0, 132.8,
@@ -60,12 +60,12 @@ def test_a_dropped_fit_beyond_the_judgement_ratio_or_another_winner_adds_nothing
     ratio = Criteria().judgement_ratio
     winner = _comp('dead_time', 0.0748)     # blind #84: the dropped lag fit stayed at 0.189
     assert hold_calls(winner, [winner, _comp('sensor_lag', 0.18, screened=0.1887)],
-                      DATA, Criteria()) == []
+                      DATA, Criteria(), DT_S) == []
     edge = _comp('sensor_lag', 0.5, screened=0.0748 * ratio * 1.001)
-    assert hold_calls(winner, [winner, edge], DATA, Criteria()) == []
+    assert hold_calls(winner, [winner, edge], DATA, Criteria(), DT_S) == []
     other = _comp('creep', 0.3918)
     assert hold_calls(other, [other, _comp('sensor_lag', 0.5, screened=0.39)],
-                      DATA, Criteria()) == []
+                      DATA, Criteria(), DT_S) == []
 
 
 def test_a_delay_of_many_samples_is_not_a_lag_behind_a_hold():
@@ -73,4 +73,4 @@ def test_a_delay_of_many_samples_is_not_a_lag_behind_a_hold():
     for delay_s, called in ((HOLD_CALL_SAMPLES * DT_S * 0.99, True),
                             (HOLD_CALL_SAMPLES * DT_S * 1.01, False), (3.4, False)):
         winner = _comp('dead_time', 0.3918, delay_s=delay_s)
-        assert bool(hold_calls(winner, [winner, lag], DATA, Criteria())) is called, delay_s
+        assert bool(hold_calls(winner, [winner, lag], DATA, Criteria(), DT_S)) is called, delay_s
