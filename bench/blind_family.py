@@ -155,6 +155,7 @@ def draw(index: int) -> dict:
 def run(index: int, workers: int = 1) -> dict:
     """Draw and diagnose one recording (``workers`` processes); what the tables need."""
     from hyst_id.diagnosis import diagnose, DiagnoseSettings
+    from hyst_id.diagnosis.blocked_cv import confirmed
     from hyst_id.io.recording import Recording
     case = draw(index)
     rec = Recording(case['t'], case['command'], case['measurement'], case['channel'],
@@ -164,13 +165,18 @@ def run(index: int, workers: int = 1) -> dict:
     j = d.extra['judged_holdout']
     out = {k: case[k] for k in ('index', 'channel', 'excitation', 'dt_s', 'effects',
                                 'magnitudes', 'noise_percent_of_span')}
-    out.update(verdict=d.verdict, found=[f.mechanism for f in d.findings],
+    held = [f for f in d.findings if confirmed(f.blocked_cv)]
+    out.update(verdict=d.verdict, found=[f.mechanism for f in held],
+               # fitted, but not held up by blocked cross-validation: stated, not claimed
+               unconfirmed=[f.mechanism for f in d.findings if f not in held],
                # per finding, the tied candidates and close calls its report names
                calls=[[a['mechanism'] for a in f.alternatives
                        if a.get('kind', 'tied') in ('tied', 'close', 'signature', 'hold')]
-                      for f in d.findings],
+                      for f in held],
                # the final residual's time x level t (driver.gain_call's signature)
                level_t=d.final_localization.trend['level_t'],
+               # blocked cross-validation: time blocks better / worse, per finding
+               blocked=[[f.blocked_cv['better'], f.blocked_cv['worse']] for f in held],
                cost=j['baseline_er_percent'] / j['noise_floor_percent'],
                final=j['final_er_percent'] / j['noise_floor_percent'],
                seconds=time.time() - t0)
@@ -371,7 +377,14 @@ def _say(r: dict, k: int, n: int, t0: float) -> None:
           f'{"+".join(r["found"]) or r["verdict"]} (final {r["final"]:.2f} x, '
           f'{r["seconds"]:.0f} s)'
           + (f'; calls: {_calls(r)}' if _calls(r) else '')
-          + (f'; final level t {r["level_t"]:.1f}' if 'level_t' in r else ''), flush=True)
+          + (f'; final level t {r["level_t"]:.1f}' if 'level_t' in r else '')
+          + (f'; blocked CV better/worse {_blocked(r)}' if r.get('blocked') else '')
+          + (f'; not confirmed: {"+".join(r["unconfirmed"])}' if r.get('unconfirmed') else ''),
+          flush=True)
+
+
+def _blocked(r: dict) -> str:
+    return ', '.join(f'{f} {b}/{w}' for f, (b, w) in zip(r['found'], r['blocked']))
 
 
 def main() -> int:

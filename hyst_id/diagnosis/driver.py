@@ -52,6 +52,7 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from hyst_id.diagnosis.baseline import baseline_starts, whole_record_er
+from hyst_id.diagnosis.blocked_cv import confirm, confirmed
 from hyst_id.diagnosis.control import drop_superseded, equivalent_chain, null_control
 from hyst_id.diagnosis.control import recheck
 from hyst_id.diagnosis.empirical import empirical_block
@@ -295,6 +296,7 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
                 f'{trained:.4g} -> {winner.fit.er_train_percent:.4g}')
         findings.append(finding_from(winner, current, mech, loc, ctx, v_orig))
         findings[-1].alternatives = alternatives
+        findings[-1].blocked_cv = confirm(current, winner.fit, data)
         current = winner.fit
         loc = locate(t, v_orig, y, current.prediction, sigma, n_train, ctx.period_s)
     notes = list(rec.notes) + range_note(v_orig, n_train, data.judged_rows.size) + chain_notes
@@ -317,9 +319,12 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
     if current.er_holdout_percent > UNKNOWN_FACTOR * floor_h:
         say('empirical block: what a model could still gain')
         empirical = empirical_block(t, v_orig, y, current.prediction, n_train, ctx.period_s)
-    extra = {}
-    if findings:
-        verdict = findings[0].mechanism
+    extra = {} if current is baseline else {'blocked_cv': confirm(baseline, current, data)}
+    held = [f for f in findings if confirmed(f.blocked_cv)]
+    if held:
+        verdict = held[0].mechanism
+    elif findings:
+        verdict = 'unknown'     # the split accepted blocks that the time blocks do not hold up
     elif rounds and current.er_holdout_percent > UNKNOWN_FACTOR * floor_h:
         verdict = 'unknown'     # something is missing, and it is none of the library
         say('the chain on the whole record: is anything missing at all?')

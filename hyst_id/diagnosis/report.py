@@ -21,6 +21,8 @@ from typing import Any
 
 import numpy as np
 
+from hyst_id.diagnosis.blocked_cv import confirmed, summary as cv_summary
+
 __all__ = ['format_diagnosis', 'plot_diagnosis', 'unknown_reading']
 
 
@@ -194,10 +196,16 @@ def format_diagnosis(d: Any) -> str:
             lines.append(f'final model: the same chain, chosen again (note below): %e_r train '
                          f'{_fmt(d.final.er_train_percent)}, held-out '
                          f'{_fmt(d.final.er_holdout_percent)}')
+    if d.findings and d.verdict == 'unknown':
+        lines.append('verdict: unknown - the blocks below predict the held-out part of this '
+                     'split better, but none holds up when each quarter of the record is '
+                     'predicted by a fit on the others (blocked cross-validation): they are '
+                     'stated, not claimed; what is missing is none of them, or not only them.')
     if d.empirical is not None:
         lines.append(f'what is left: {d.empirical.summary()}.')
     for i, f in enumerate(d.findings):
-        head = 'verdict' if i == 0 else f'finding {i + 1}'
+        head = ('verdict' if f.mechanism == d.verdict else f'finding {i + 1}'
+                if confirmed(f.blocked_cv) else f'not confirmed ({i + 1})')
         gain = 100 * (1 - f.er_holdout_after_percent / f.er_holdout_before_percent)
         lines += [f'{head}: {f.mechanism} - {f.title}', f'    {f.explanation}',
                   f'    placed: {f.placement}', '    fitted block:']
@@ -208,6 +216,8 @@ def format_diagnosis(d: Any) -> str:
                      f'delta BIC {f.delta_bic:.0f}, held-out z {f.holdout_z:.1f}')
         if f.compensation:
             lines.append(f'    compensation: {f.compensation["how"]}')
+        if f.blocked_cv:
+            lines.append(f'    {cv_summary(f.blocked_cv)}')
         lines += _alternative_lines(f)
         lines.append('')
     if d.findings:
@@ -223,6 +233,8 @@ def format_diagnosis(d: Any) -> str:
                          f'{_fmt(j["baseline_er_percent"])} -> {_fmt(j["final_er_percent"])} '
                          f'= {j["final_er_percent"] / j["noise_floor_percent"]:.2f} x the '
                          'noise floor there')
+        if 'blocked_cv' in d.extra:
+            lines.append(f'final model against the baseline: {cv_summary(d.extra["blocked_cv"])}')
         fl = d.final_localization
         lines.append('remaining residual: ' + ('white and independent of the command'
                                                if not fl.structured else

@@ -104,6 +104,9 @@ class Finding:
     #: 'correction': {augment.* values}}`` (:data:`hyst_id.diagnosis.mechanisms.base.
     #: COMPENSATION_KINDS`; the correction is empty without an in-line one).
     compensation: dict = field(default_factory=dict)
+    #: the block against the model before it, each time block of the record predicted by
+    #: a refit on the others (:func:`hyst_id.diagnosis.blocked_cv.confirm`), at acceptance
+    blocked_cv: dict = field(default_factory=dict)
 
     def to_dict(self) -> dict:
         """JSON-ready form."""
@@ -116,7 +119,8 @@ class Finding:
                 'er_holdout_after_percent': self.er_holdout_after_percent,
                 'delta_bic': self.delta_bic, 'holdout_z': self.holdout_z,
                 'alternatives': list(self.alternatives),
-                'compensation': dict(self.compensation)}
+                'compensation': dict(self.compensation),
+                'blocked_cv': jsonable(self.blocked_cv)}
 
 
 @dataclass
@@ -205,7 +209,7 @@ class Diagnosis:
                             + (f': {self.empirical.summary()}' if self.empirical else '')), values
         if not self.findings:
             return 'ok', 'no missing physics found', values
-        f = self.findings[0]
+        f = next(f for f in self.findings if f.mechanism == self.verdict)
         return 'warn', f'{f.mechanism}: {f.explanation.split(". ")[0]}', values
 
     def report(self) -> str:
