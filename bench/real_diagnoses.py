@@ -19,7 +19,8 @@ against piston displacement; B(H) loops with the sample index as time) and
 diagnosed blind with the default settings. Printed per recording: the
 baseline's training and held-out %e_r, every finding with its block's
 parameters and the held-out %e_r after it, the final held-out %e_r over the
-noise floor, the rows the criteria judged on, the hold convention, the notes.
+noise floor, the rows the criteria judged on, the hold convention, the notes,
+and each finding's blocked cross-validation (time blocks better / worse).
 
 Usage (from the repository root; a few minutes in all)::
 
@@ -40,6 +41,7 @@ sys.path.insert(0, str(ROOT))
 from real_recordings import load_all  # noqa: E402, I100
 
 from hyst_id.diagnosis import diagnose  # noqa: E402, I100
+from hyst_id.diagnosis.blocked_cv import confirmed  # noqa: E402
 from hyst_id.diagnosis.export import compensator_set  # noqa: E402
 from hyst_id.errors import HystIdError  # noqa: E402
 
@@ -64,8 +66,11 @@ def main() -> int:
               f'{d.verdict}; baseline %e_r train {d.baseline.er_train_percent:.3g} / held-out '
               f'{d.baseline.er_holdout_percent:.3g}; noise floor {d.noise_floor_percent:.3g}')
         for f in d.findings:
+            cv = f.blocked_cv
             print(f'  {f.mechanism}: {_params(f)} (held-out {f.er_holdout_before_percent:.3g} '
-                  f'-> {f.er_holdout_after_percent:.3g})')
+                  f'-> {f.er_holdout_after_percent:.3g}); blocked CV better {cv["better"]}, '
+                  f'worse {cv["worse"]} of {cv["blocks"]}'
+                  + ('' if confirmed(cv) else ': not confirmed'))
         try:
             model, aug, _ = compensator_set(d)
             print(f'  compensator set ({model.family}): in-line {aug.describe()}')

@@ -65,9 +65,9 @@ N_BLOCKS = 4
 
 #: a block the model without it predicts better in at least this many time blocks (and
 #: in at least as many as the block helps) is not confirmed (:func:`confirmed`). On 48
-#: recordings of the blind family (``bench/blind_family.py --indices ...``, docs) the 30
-#: findings that were an effect of the recording were worse in 0 (24) or 1 (6) of 4
-#: blocks; findings that were not were worse in up to 3
+#: recordings of the blind family (``bench/blind_family.py --indices ...``, the command in
+#: docs/diagnosis.md) the 31 findings that were an effect of the recording were worse in
+#: 0 (25) or 1 (6) of the time blocks; 5 of the 23 that were not were worse in 2 or 3
 UNCONFIRMED_WORSE = 2
 
 

@@ -26,6 +26,7 @@ from typing import Any, Callable
 
 import numpy as np
 
+from hyst_id.diagnosis.blocked_cv import confirmed
 from hyst_id.diagnosis.locate import Localization
 from hyst_id.diagnosis.select import Criteria, FitResult
 from hyst_id.io.jsonable import jsonable
@@ -199,6 +200,9 @@ class Diagnosis:
                   'final_er_holdout_percent': f'{self.final.er_holdout_percent:.4g}',
                   'noise_floor_percent': f'{self.noise_floor_percent:.4g}',
                   'mechanisms': ','.join(f.mechanism for f in self.findings)}
+        shaky = [f.mechanism for f in self.findings if not confirmed(f.blocked_cv)]
+        if shaky:       # fitted on the split, not held up by blocked cross-validation
+            values['not_confirmed'] = ','.join(shaky)
         for f in self.findings:
             for name, q in f.params.items():
                 values[f'{f.mechanism}.{name}'] = f'{q.value:.4g} {q.unit}'.strip()

@@ -29,6 +29,7 @@ import numpy as np
 
 from hyst_id.compensation import InverseModel
 from hyst_id.compensation.params_file import compensator_names
+from hyst_id.diagnosis.blocked_cv import confirmed
 from hyst_id.errors import InvalidParametersError
 from hyst_id.identification import Identification
 from hyst_id.identification.chains import chain_spec
@@ -135,7 +136,9 @@ def diagnosis_statuses(doc: dict) -> list[tuple[int, str, str, dict[str, Any]]]:
     the chain, the held-out and training %e_r before and after adding it,
     its parameters (``name: value unit``) and how the block is compensated
     (``compensation``: kind, ``compensation_how``: words) and the blocks that
-    explain it nearly as well (``judgement_call``). No finding gives one level 0
+    explain it nearly as well (``judgement_call``), its blocked cross-validation
+    (``blocked_cv``; ``confirmed: false`` and the message says so when it does
+    not hold the block up). No finding gives one level 0
     status with the verdict, the held-out %e_r and the noise floor.
     """
     out = []
@@ -163,6 +166,13 @@ def diagnosis_statuses(doc: dict) -> list[tuple[int, str, str, dict[str, Any]]]:
         if close:       # the data barely prefer this block
             values['judgement_call'] = ', '.join(close)
         message = str(f.get('explanation') or f.get('title') or f.get('mechanism', ''))
+        cv = f.get('blocked_cv') or {}
+        if cv:          # blocked cross-validation: time blocks better / worse with the block
+            values['blocked_cv'] = (f"better in {cv.get('better')}, worse in "
+                                    f"{cv.get('worse')} of {cv.get('blocks')} time blocks")
+            if not confirmed(cv):
+                values['confirmed'] = 'false'
+                message = 'not confirmed across time blocks (stated, not claimed): ' + message
         out.append((1, str(f.get('mechanism', '?')), message, values))
     if not out:
         base = doc.get('baseline') or {}

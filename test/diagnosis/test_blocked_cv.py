@@ -128,3 +128,20 @@ def test_any_number_of_blocks_covers_the_record(n_blocks):
     assert len(p.bounds) == n_blocks
     assert all(p.bounds[k][1] == p.bounds[k + 1][0] for k in range(n_blocks - 1))
     assert sum(j.size for j in p.judged) + sum(p.n_extrapolated) == data.y.size
+
+
+def test_diagnostics_say_when_a_finding_is_not_confirmed():
+    from hyst_id.live.documents import diagnosis_statuses
+
+    def doc(better, worse):
+        return {'verdict': 'unknown', 'findings': [{
+            'mechanism': 'dead_time', 'explanation': 'a delay',
+            'blocked_cv': {'blocks': 4, 'better': better, 'worse': worse}}]}
+
+    (_, _, message, values), = diagnosis_statuses(doc(1, 3))
+    assert values['confirmed'] == 'false' and message.startswith('not confirmed')
+    assert values['blocked_cv'] == 'better in 1, worse in 3 of 4 time blocks'
+    (_, _, message, values), = diagnosis_statuses(doc(3, 1))
+    assert 'confirmed' not in values and message == 'a delay'
+    assert not confirmed({'better': 2, 'worse': 2}) and confirmed({'better': 3, 'worse': 1})
+    assert confirmed({'better': 0, 'worse': 1})      # one block is not enough against it
