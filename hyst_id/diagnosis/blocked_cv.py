@@ -22,8 +22,13 @@ acts elsewhere. Blocked cross-validation cuts the whole record into
 (bounded least squares from the model's values, all parameters free, the
 linear part solved again) on the samples *outside* the block and predicts
 the block. A hysteresis carries its state through the block, so the model
-is simulated over the whole record and only the fit is masked; the outputs
-of the block never reach the fit.
+is simulated over the whole record and only the fit is masked: the block's
+outputs are not in the refit's residuals nor in its linear solve. The refit
+starts from the model's values, fitted on the training part, and its budget
+is small (``max_nfev``), so the nonlinear parameters stay near values that
+saw the first blocks' outputs: for those blocks the figures lean optimistic,
+for both models alike (the comparison is between them); the last block
+(held out of the training part) is clean.
 
 Each block is judged on its samples whose command lies inside the range the
 fitting samples cover (within ``tol`` of it); the others are extrapolation,
@@ -46,7 +51,7 @@ the two, and it confirms the single split's claims rather than deciding ties.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.optimize import least_squares
@@ -54,6 +59,7 @@ from scipy.optimize import least_squares
 from hyst_id.diagnosis.mechanisms.base import clip_theta
 from hyst_id.diagnosis.model import ComposedModel, solve_linear
 from hyst_id.diagnosis.select import Data, FitResult, improvement_z
+from hyst_id.errors import ConfigError
 from hyst_id.identification.chains import er_percent
 
 __all__ = ['BlockPrediction', 'BlockVerdict', 'block_predictions', 'compare_blocked',
@@ -83,6 +89,8 @@ class BlockPrediction:
     judged: list[np.ndarray]
     #: rows of each block whose command lies outside the fitted range
     n_extrapolated: list[int]
+    #: rows of the first block inside the range but before the command swept it
+    n_unswept: list[int] = field(default_factory=list)
     #: function evaluations the fits took
     nfev: int = 0
 
@@ -100,6 +108,7 @@ class BlockVerdict:
     z_back: list[float]
     n_judged: list[int]
     n_extrapolated: list[int]
+    n_unswept: list[int]
     #: blocks where B predicts significantly better (``z`` above ``z_min``, lower %e_r)
     better: int
     #: blocks where A predicts significantly better (``z_back`` above ``z_min``, lower %e_r)
@@ -116,7 +125,8 @@ class BlockVerdict:
                 'er_a_percent': self.er_a_percent, 'er_b_percent': self.er_b_percent,
                 'noise_floor_percent': self.floor_percent, 'z': self.z,
                 'z_back': self.z_back,
-                'n_judged': self.n_judged, 'n_extrapolated': self.n_extrapolated}
+                'n_judged': self.n_judged, 'n_extrapolated': self.n_extrapolated,
+                'n_unswept': self.n_unswept}
 
 
 def _block_bounds(t_s: np.ndarray, n_blocks: int) -> list[tuple[int, int]]:
@@ -184,11 +194,19 @@ def block_predictions(fit: FitResult, data: Data, *, n_blocks: int = N_BLOCKS,
     -------
     BlockPrediction
     """
+    if not 2 <= n_blocks <= data.y.size // 10:
+        raise ConfigError(f'blocked cross-validation needs 2 to {data.y.size // 10} blocks '
+                          f'of at least 10 samples, got {n_blocks}')
     bounds = _block_bounds(data.t_s, n_blocks)
     pred = np.array(fit.prediction, dtype=float)
-    judged, extrapolated, nfev = [], [], 0
+    judged, extrapolated, unswept, nfev = [], [], [], 0
     every = np.arange(data.y.size)
     for a, b in bounds:
+        if b <= a:      # no sample in this block (a gap in the record)
+            judged.append(every[a:a])
+            extrapolated.append(0)
+            unswept.append(0)
+            continue
         rows = np.concatenate([every[:a], every[b:]])
         _, whole, k = _refit(fit.model, data, fit.p, rows, max_nfev)
         nfev += k
@@ -196,12 +214,13 @@ def block_predictions(fit: FitResult, data: Data, *, n_blocks: int = N_BLOCKS,
         lo, hi = float(np.min(data.v[rows])), float(np.max(data.v[rows]))
         margin = tol * (hi - lo)
         inside = (data.v[a:b] >= lo - margin) & (data.v[a:b] <= hi + margin)
-        if a == 0:      # until the command has swept the range, the record's initial state
-            inside &= _swept(data.v[a:b], lo + margin, hi - margin)
-        judged.append(every[a:b][inside])
+        swept = (_swept(data.v[a:b], lo + margin, hi - margin) if a == 0
+                 else np.ones(b - a, dtype=bool))   # before: the record's initial state
+        judged.append(every[a:b][inside & swept])
         extrapolated.append(int(np.count_nonzero(~inside)))
+        unswept.append(int(np.count_nonzero(inside & ~swept)))
     return BlockPrediction(bounds=bounds, prediction=pred, judged=judged,
-                           n_extrapolated=extrapolated, nfev=nfev)
+                           n_extrapolated=extrapolated, n_unswept=unswept, nfev=nfev)
 
 
 def compare_blocked(a: BlockPrediction, b: BlockPrediction, data: Data, *,
@@ -232,6 +251,7 @@ def compare_blocked(a: BlockPrediction, b: BlockPrediction, data: Data, *,
                                      data.noise_std))
     return BlockVerdict(er_a_percent=er_a, er_b_percent=er_b, floor_percent=floors, z=zs,
                         z_back=zs_back, n_judged=n_j, n_extrapolated=list(a.n_extrapolated),
+                        n_unswept=list(a.n_unswept),
                         better=sum(1 for z, a_, b_ in zip(zs, er_a, er_b)
                                    if z > z_min and b_ < a_),
                         worse=sum(1 for z, a_, b_ in zip(zs_back, er_a, er_b)
@@ -252,7 +272,8 @@ def confirm(before: FitResult, after: FitResult, data: Data, *, n_blocks: int = 
     a = block_predictions(before, data, n_blocks=n_blocks, max_nfev=max_nfev)
     b = block_predictions(after, data, n_blocks=n_blocks, max_nfev=max_nfev)
     out = compare_blocked(a, b, data, z_min=z_min).to_dict()
-    out['t_s'] = [[float(data.t_s[i]), float(data.t_s[j - 1])] for i, j in a.bounds]
+    out['t_s'] = [[float(data.t_s[i]), float(data.t_s[j - 1])] if j > i
+                  else [float('nan')] * 2 for i, j in a.bounds]
     out['z_min'] = z_min
     return out
 
@@ -262,20 +283,24 @@ def confirmed(cv: dict) -> bool:
 
     Not confirmed: the model without the block predicts at least
     :data:`UNCONFIRMED_WORSE` time blocks better and at least as many as the
-    block improves. An empty ``cv`` (not computed) confirms.
+    block improves. An empty ``cv`` (not computed), or one that judged no
+    block, confirms: with nothing judged there is nothing against the block.
     """
     if not cv:
         return True
-    return not (cv['worse'] >= UNCONFIRMED_WORSE and cv['worse'] >= cv['better'])
+    worse, better = int(cv.get('worse') or 0), int(cv.get('better') or 0)
+    return not (worse >= UNCONFIRMED_WORSE and worse >= better)
 
 
 def summary(cv: dict) -> str:
     """One sentence: in how many time blocks the model with the block predicts better."""
     ratios = ', '.join(f'{b / a:.2f}' if a > 0 else '-'
                        for a, b in zip(cv['er_a_percent'], cv['er_b_percent']))
-    extra = sum(cv['n_extrapolated'])
+    extra, unswept = sum(cv['n_extrapolated']), sum(cv.get('n_unswept') or [0])
     tail = (f'; {extra} samples outside the fitted command range not judged'
             if extra else '')
+    tail += (f'; {unswept} samples of the first block before the command swept the range '
+             'not judged' if unswept else '')
     return (f"blocked cross-validation ({cv['blocks']} time blocks, each predicted by a refit "
             f"on the others): better in {cv['better']}, worse in {cv['worse']} "
             f"(|z| > {cv['z_min']:g}); %e_r after / before per block {ratios}{tail}")

@@ -30,6 +30,7 @@ from hyst_id.diagnosis.blocked_cv import (
 from hyst_id.diagnosis.mechanisms import Context, MECHANISMS
 from hyst_id.diagnosis.model import ComposedModel
 from hyst_id.diagnosis.select import Data, evaluate
+from hyst_id.errors import ConfigError
 from hyst_id.identification.chains import chain_spec
 from hyst_id.signals.excitation import multisine
 
@@ -70,6 +71,8 @@ def test_the_true_block_is_confirmed_in_every_block():
     data, plain, delayed = _record()
     cv = confirm(plain, delayed, data)
     assert cv['blocks'] == 3 and cv['n_judged'][0] == 0    # the first quarter: not swept
+    assert cv['n_unswept'][0] + cv['n_extrapolated'][0] == 600
+    assert 'before the command swept the range' in summary(cv)
     assert cv['better'] == 3 and cv['worse'] == 0, cv
     assert all(b < 0.8 * a for a, b in zip(cv['er_a_percent'][1:], cv['er_b_percent'][1:]))
     back = confirm(delayed, plain, data)     # the other way round: worse everywhere
@@ -95,6 +98,11 @@ def test_the_first_block_is_judged_once_the_command_has_swept_its_range():
 
 
 def test_a_block_s_outputs_never_reach_its_fit():
+    """Through the residuals and the linear solve; both runs start from the same values.
+
+    (The start itself comes from a fit on the training part: the module's
+    docstring says what that means for the first blocks.)
+    """
     data, _, delayed = _record()
     before = block_predictions(delayed, data)
     a, b = before.bounds[2]
@@ -127,7 +135,15 @@ def test_any_number_of_blocks_covers_the_record(n_blocks):
     p = block_predictions(plain, data, n_blocks=n_blocks, max_nfev=5)
     assert len(p.bounds) == n_blocks
     assert all(p.bounds[k][1] == p.bounds[k + 1][0] for k in range(n_blocks - 1))
-    assert sum(j.size for j in p.judged) + sum(p.n_extrapolated) == data.y.size
+    assert (sum(j.size for j in p.judged) + sum(p.n_extrapolated) + sum(p.n_unswept)
+            == data.y.size)
+
+
+@pytest.mark.parametrize('n_blocks', [1, 0, 10_000])
+def test_an_impossible_number_of_blocks_is_a_config_error(n_blocks):
+    data, plain, _ = _record()
+    with pytest.raises(ConfigError, match='blocks'):
+        block_predictions(plain, data, n_blocks=n_blocks)
 
 
 def test_diagnostics_say_when_a_finding_is_not_confirmed():
@@ -145,3 +161,4 @@ def test_diagnostics_say_when_a_finding_is_not_confirmed():
     assert 'confirmed' not in values and message == 'a delay'
     assert not confirmed({'better': 2, 'worse': 2}) and confirmed({'better': 3, 'worse': 1})
     assert confirmed({'better': 0, 'worse': 1})      # one block is not enough against it
+    assert confirmed({'blocks': 0}) and confirmed({'worse': None, 'better': None})
