@@ -52,7 +52,7 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from hyst_id.diagnosis.baseline import baseline_starts, whole_record_er
-from hyst_id.diagnosis.blocked_cv import confirm, confirmed
+from hyst_id.diagnosis.blocked_cv import BlockedCV, confirmed
 from hyst_id.diagnosis.control import drop_superseded, equivalent_chain, null_control
 from hyst_id.diagnosis.control import recheck
 from hyst_id.diagnosis.empirical import empirical_block
@@ -238,6 +238,7 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
     say(f'baseline: %e_r train {baseline.er_train_percent:.4g}, held-out '
         f'{baseline.er_holdout_percent:.4g} (noise floor {floor_h:.3g})')
     current, loc, findings, rounds = baseline, loc0, [], []
+    blocked = BlockedCV(data)
     rechosen, chain_notes = False, []
     for round_no in range(settings.max_mechanisms):
         if not loc.structured and current.er_holdout_percent <= 1.5 * floor_h:
@@ -296,7 +297,7 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
                 f'{trained:.4g} -> {winner.fit.er_train_percent:.4g}')
         findings.append(finding_from(winner, current, mech, loc, ctx, v_orig))
         findings[-1].alternatives = alternatives
-        findings[-1].blocked_cv = confirm(current, winner.fit, data)
+        findings[-1].blocked_cv = blocked.confirm(current, winner.fit)
         current = winner.fit
         loc = locate(t, v_orig, y, current.prediction, sigma, n_train, ctx.period_s)
     notes = list(rec.notes) + range_note(v_orig, n_train, data.judged_rows.size) + chain_notes
@@ -319,7 +320,7 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
     if current.er_holdout_percent > UNKNOWN_FACTOR * floor_h:
         say('empirical block: what a model could still gain')
         empirical = empirical_block(t, v_orig, y, current.prediction, n_train, ctx.period_s)
-    extra = {} if current is baseline else {'blocked_cv': confirm(baseline, current, data)}
+    extra = {} if current is baseline else {'blocked_cv': blocked.confirm(baseline, current)}
     held = [f for f in findings if confirmed(f.blocked_cv)]
     if held:
         verdict = held[0].mechanism

@@ -191,14 +191,14 @@ def evaluate(model: ComposedModel, data: Data, p: np.ndarray, nfev: int = 0) -> 
 
 
 class _Objective:
-    """Training residual of a model over a subset of its parameters."""
+    """Residual of a model over a subset of its parameters, on the training part or ``rows``."""
 
     def __init__(self, model: ComposedModel, data: Data, p_base: np.ndarray,
-                 free: np.ndarray) -> None:
-        self.model = model
-        self.t = data.t_s[:data.n_train]
-        self.v = data.v[:data.n_train]
-        self.y = data.y[:data.n_train]
+                 free: np.ndarray, rows: np.ndarray | None = None) -> None:
+        self.model, self.rows, self.n_span = model, rows, data.n_train
+        whole = slice(None) if rows is not None else slice(data.n_train)
+        self.t, self.v = data.t_s[whole], data.v[whole]
+        self.y = data.y[rows] if rows is not None else data.y[:data.n_train]
         self.p = np.array(p_base, dtype=float)
         self.free = free
         self.penalty = np.full(self.y.size, 10.0 * np.sqrt(np.mean(self.y ** 2)))
@@ -214,7 +214,8 @@ class _Objective:
         p = self.full(q)
         if not self.model.feasible(p):
             return self.penalty
-        a = self.model.evaluate(p, self.t, self.v, self.t.size).matrix()
+        a = self.model.evaluate(p, self.t, self.v, self.n_span).matrix()
+        a = a if self.rows is None else a[self.rows]    # the whole record simulated
         coef, _ = solve_linear(a, self.y)
         return self.y - a @ coef
 
@@ -224,13 +225,17 @@ class _Objective:
 
 
 def polish(model: ComposedModel, data: Data, p0: np.ndarray, *, free: np.ndarray | None = None,
-           max_nfev: int = 400) -> tuple[np.ndarray, float, int]:
-    """Bounded least squares over the free parameters (all by default) from p0."""
+           max_nfev: int = 400, rows: np.ndarray | None = None
+           ) -> tuple[np.ndarray, float, int]:
+    """Bounded least squares over the free parameters (all by default) from p0.
+
+    On the training part, or on ``rows`` (absolute indices) of the whole record.
+    """
     free = np.arange(model.n_params) if free is None else np.asarray(free)
     lo, hi = model.bounds[free, 0], model.bounds[free, 1]
     p0 = np.array(p0, dtype=float)
     p0[free] = clip_theta(p0[free], model.bounds[free])
-    obj = _Objective(model, data, p0, free)
+    obj = _Objective(model, data, p0, free, rows)
     q0 = p0[free]
     f0 = obj.sse(q0)
     if free.size == 0 or max_nfev < 2 * (free.size + 1):
