@@ -171,7 +171,7 @@ def run(index: int, workers: int = 1) -> dict:
                unconfirmed=[f.mechanism for f in d.findings if f not in held],
                # per finding, the tied candidates and close calls its report names
                calls=[[a['mechanism'] for a in f.alternatives
-                       if a.get('kind', 'tied') in ('tied', 'close', 'signature', 'hold')]
+                       if a.get('kind', 'tied') in ('tied', 'close', 'signature', 'hold', 'split')]
                       for f in held],
                # the final residual's time x level t (driver.gain_call's signature)
                level_t=d.final_localization.trend['level_t'],

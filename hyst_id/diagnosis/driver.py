@@ -52,7 +52,7 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from hyst_id.diagnosis.baseline import baseline_starts, whole_record_er
-from hyst_id.diagnosis.blocked_cv import BlockedCV, confirmed
+from hyst_id.diagnosis.blocked_cv import BlockedCV, confirmed, split_record
 from hyst_id.diagnosis.control import drop_superseded, equivalent_chain, null_control
 from hyst_id.diagnosis.control import recheck
 from hyst_id.diagnosis.empirical import empirical_block
@@ -260,6 +260,14 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
             current = null
             loc = locate(t, v_orig, y, current.prediction, sigma, n_train, ctx.period_s)
             winner, tied = choose(comps, data, settings.criteria)
+        split = None
+        if winner is not None:
+            split = winner
+            winner, split_cv = blocked.decide(winner, tied + close_calls(
+                comps, winner, tied, data, settings.criteria))
+            if winner is not split:
+                say(f'round {round_no + 1}: {winner.mechanism} predicts every time block '
+                    f'better than {split.mechanism}, which led on the short judged split')
         rounds.append(round_record(round_no + 1, comps, winner, data))
         if winner is None and not rechosen:
             other = equivalent_chain(comps, current, data, settings.criteria,
@@ -276,12 +284,15 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
         mech = next(m for m in mechs if m.id == winner.mechanism)
         alternatives = alternatives_record(
             tied, close_calls(comps, winner, tied, data, settings.criteria), data)
+        if winner is not split:     # decided by blocked cross-validation: the split's winner
+            alternatives = [split_record(split, winner, data, split_cv)]
         named = {a['mechanism'] for a in alternatives}
         calls = hold_calls(winner, comps, data, settings.criteria, ctx.dt_s)
         alternatives += [a for a in calls if a['mechanism'] not in named]
         first, trained = winner, winner.fit.er_train_percent
         winner, contested = contest(winner, comps, data, ctx, spec, settings,
                                     floor_train_percent=floor_t,
+                                    beats=blocked.beats if blocked.split_short else None,
                                     say=lambda text: say(f'round {round_no + 1}: {text}'))
         if winner is not first:
             mech = next(m for m in mechs if m.id == winner.mechanism)

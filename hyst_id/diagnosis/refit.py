@@ -167,7 +167,7 @@ def _reidentify_once(fit: FitResult, data, ctx, spec: ChainSpec, settings,
 
 
 def contest(winner, comps: list, data, ctx, spec: ChainSpec, settings, *,
-            floor_train_percent: float, say=None) -> tuple:
+            floor_train_percent: float, say=None, beats=None) -> tuple:
     """The round's winner re-identified, or a runner-up whose re-identified chain beats it.
 
     Parameters
@@ -181,6 +181,12 @@ def contest(winner, comps: list, data, ctx, spec: ChainSpec, settings, *,
     say : callable, optional
         Progress words (``say(text)``) before each identification of the winner's
         chain and before each runner-up's re-identification.
+    beats : callable, optional
+        ``beats(fit, rival_fit)``: whether a re-identified runner-up takes the
+        round from the current choice. Default: its judged held-out %e_r is
+        below the choice's by more than ``criteria.tie_ratio``; the diagnosis
+        passes :meth:`hyst_id.diagnosis.blocked_cv.BlockedCV.beats` when the
+        split judged too little to decide alone.
 
     Returns
     -------
@@ -213,6 +219,9 @@ def contest(winner, comps: list, data, ctx, spec: ChainSpec, settings, *,
                            floor_train_percent=floor_train_percent)
         er = data.judged_er_percent(c.fit)
         record.append({'mechanism': c.mechanism, 'er_judged_after_percent': er})
-        if er * settings.criteria.tie_ratio < data.judged_er_percent(chosen.fit):
+        if beats is None:
+            if er * settings.criteria.tie_ratio < data.judged_er_percent(chosen.fit):
+                chosen = c
+        elif beats(chosen.fit, c.fit):
             chosen = c
     return chosen, record

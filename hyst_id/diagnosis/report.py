@@ -46,6 +46,16 @@ def _alternative_lines(f: Any) -> list[str]:
                          f're-identified with each block, {f.mechanism} predicts the held-out '
                          'part better '
                          f'(judged {_fmt(a["er_judged_after_percent"])} for {a["mechanism"]})')
+        if a.get('kind') == 'split':
+            cv = a['blocked_cv']
+            lines.append(f'    a judgement call: {a["mechanism"]} led on the judged held-out '
+                         f'samples (%e_r {_fmt(a["er_judged_after_percent"])} against '
+                         f'{_fmt(a["er_judged_chosen_percent"])}), but the split judged only '
+                         f'{a["n_judged"]} of {a["n_holdout"]} (the command then leaves the '
+                         f'training range); refitted per time block, {f.mechanism} predicts '
+                         f'all {cv["blocks"]} judged blocks better (held-out '
+                         f'{_fmt(f.er_holdout_after_percent)} against '
+                         f'{_fmt(a["er_holdout_after_percent"])} on all held-out samples)')
     if tied:
         lines.append('    also consistent with the data (tied, decided by training BIC '
                      f'and evidence): {_alts(tied)}')

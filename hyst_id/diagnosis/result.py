@@ -119,7 +119,7 @@ class Finding:
                 'er_holdout_before_percent': self.er_holdout_before_percent,
                 'er_holdout_after_percent': self.er_holdout_after_percent,
                 'delta_bic': self.delta_bic, 'holdout_z': self.holdout_z,
-                'alternatives': list(self.alternatives),
+                'alternatives': jsonable(list(self.alternatives)),
                 'compensation': dict(self.compensation),
                 'blocked_cv': jsonable(self.blocked_cv)}
 

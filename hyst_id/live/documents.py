@@ -162,7 +162,8 @@ def diagnosis_statuses(doc: dict) -> list[tuple[int, str, str, dict[str, Any]]]:
             values['compensation'] = str(comp.get('kind', ''))
             values['compensation_how'] = str(comp.get('how', ''))
         close = [a['mechanism'] for a in f.get('alternatives') or ()
-                 if isinstance(a, dict) and a.get('kind') in ('close', 'signature', 'hold')]
+                 if isinstance(a, dict)
+                 and a.get('kind') in ('close', 'signature', 'hold', 'split')]
         if close:       # the data barely prefer this block
             values['judgement_call'] = ', '.join(close)
         message = str(f.get('explanation') or f.get('title') or f.get('mechanism', ''))

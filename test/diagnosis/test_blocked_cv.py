@@ -22,14 +22,17 @@ it says on records of the independent reference simulator is in
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 
 from hyst_id.diagnosis.blocked_cv import (
-    block_predictions, compare_blocked, confirm, confirmed, summary)
+    block_predictions, BlockedCV, compare_blocked, confirm, confirmed, split_record, summary)
 from hyst_id.diagnosis.mechanisms import Context, MECHANISMS
 from hyst_id.diagnosis.model import ComposedModel
-from hyst_id.diagnosis.select import Data, evaluate
+from hyst_id.diagnosis.report import _alternative_lines
+from hyst_id.diagnosis.select import Comparison, Data, evaluate
 from hyst_id.errors import ConfigError
 from hyst_id.identification.chains import chain_spec
 from hyst_id.signals.excitation import multisine
@@ -162,3 +165,45 @@ def test_diagnostics_say_when_a_finding_is_not_confirmed():
     assert not confirmed({'better': 2, 'worse': 2}) and confirmed({'better': 3, 'worse': 1})
     assert confirmed({'better': 0, 'worse': 1})      # one block is not enough against it
     assert confirmed({'blocks': 0}) and confirmed({'worse': None, 'better': None})
+
+
+def _comparison(name, fit):
+    return Comparison(mechanism=name, fit=fit, delta_bic=0.0, holdout_z=0.0, gain=0.0,
+                      accepted=True, status='accepted')
+
+
+def _short_split(data, n_judged):
+    """The same record, its split judging only the first ``n_judged`` held-out samples."""
+    return Data(t_s=data.t_s, v=data.v, y=data.y, n_train=data.n_train,
+                noise_std=data.noise_std, judged=np.arange(data.n_train, data.n_train + n_judged))
+
+
+def test_time_blocks_decide_a_round_only_when_the_split_judged_too_little():
+    full, plain, delayed = _record()
+    short = _short_split(full, 60)            # 60 of 720 held-out samples
+    assert not BlockedCV(full).split_short and BlockedCV(short).split_short
+    wrong, right = _comparison('creep', plain), _comparison('dead_time', delayed)
+    # the split's winner stands when the split judged most of its held-out part
+    assert BlockedCV(full).decide(wrong, [right]) == (wrong, {})
+    cv = BlockedCV(short)
+    chosen, record = cv.decide(wrong, [right])
+    assert chosen is right and record['over'] == 'creep'
+    assert record['better'] == record['blocks'] == 3 and record['worse'] == 0
+    assert cv.decide(right, [wrong]) == (right, {})       # never towards the worse model
+    assert cv.decide(right, []) == (right, {})
+    assert cv.beats(plain, delayed) is not None and cv.beats(delayed, plain) is None
+    assert cv.beats(plain, plain) is None                 # the same model is not better
+    alt = split_record(wrong, right, short, record)
+    assert alt['kind'] == 'split' and (alt['n_judged'], alt['n_holdout']) == (60, 720)
+    finding = SimpleNamespace(mechanism='dead_time', alternatives=[alt],
+                              er_holdout_after_percent=right.fit.er_holdout_percent)
+    line, = _alternative_lines(finding)
+    assert 'a judgement call: creep led on the judged held-out samples' in line
+    assert 'the split judged only 60 of 720' in line
+    assert 'dead_time predicts all 3 judged blocks better' in line
+    from hyst_id.io.jsonable import jsonable
+    from hyst_id.live.documents import diagnosis_statuses
+    doc = {'verdict': 'dead_time', 'findings': [{
+        'mechanism': 'dead_time', 'explanation': 'a delay', 'alternatives': jsonable([alt])}]}
+    (_, _, _, values), = diagnosis_statuses(doc)
+    assert values['judgement_call'] == 'creep'
