@@ -58,6 +58,7 @@ from several sessions, each measured the same way.
 from __future__ import annotations
 
 import argparse
+from collections import Counter
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 import hashlib
 import inspect
@@ -248,6 +249,7 @@ def summary(rows: list[dict], how: str = 'one worker each') -> str:
         lo = [r for r in has if r['cost'] <= 3.0]
         lines.append(f'| {e} | {len(has)} | {len(hi)} | {sum(e in r["found"] for r in hi)} | '
                      f'{sum(e in r["found"] for r in lo)}/{len(lo)} |')
+    lines += ['', blocked_tally(rows)]
     wrong = [r for r in big if not _right(r)]
     lines += ['', 'Misses where the effects cost > 3 x the floor:', '']
     lines += [f'- #{r["index"]} {r["channel"]}, {r["excitation"]}, {1 / r["dt_s"]:g} Hz: '
@@ -256,6 +258,28 @@ def summary(rows: list[dict], how: str = 'one worker each') -> str:
               + (f'; judgement calls stated: {_calls(r)}' if any(r.get('calls', [])) else '')
               for r in wrong] or ['- none']
     return '\n'.join(lines)
+
+
+def blocked_tally(rows: list[dict]) -> str:
+    """Blocked cross-validation of the findings, split by whether each is an effect of its record.
+
+    Rows from runs before blocked cross-validation (no ``unconfirmed``) are left out.
+    """
+    rows = [r for r in rows if 'unconfirmed' in r]
+    if not rows:
+        return 'Blocked cross-validation: not in these rows (a run before it).'
+    true = [(b, w) for r in rows for f, (b, w) in zip(r['found'], r['blocked'])
+            if f in r['effects']]
+    other = [(b, w) for r in rows for f, (b, w) in zip(r['found'], r['blocked'])
+             if f not in r['effects']]
+    true_out = sum(f in r['effects'] for r in rows for f in r['unconfirmed'])
+    other_out = sum(f not in r['effects'] for r in rows for f in r['unconfirmed'])
+    worse = ', '.join(f'{k}: {n}' for k, n in sorted(Counter(w for _, w in true).items()))
+    return (f'Blocked cross-validation ({len(rows)} recordings): findings that are an effect '
+            f'of their recording confirmed {len(true)}/{len(true) + true_out} (worse in '
+            f'how many time blocks -> findings: {worse or "-"}); findings that are not an '
+            f'effect not confirmed {other_out}/{len(other) + other_out} (stated, not claimed; '
+            f'the verdict is the first confirmed finding, or `unknown`).')
 
 
 def _calls(r: dict) -> str:

@@ -92,3 +92,18 @@ def test_the_time_line_compares_the_same_recordings_only():
         'seconds per recording on the same 2 recordings, median: 25 -> 50 (2.0 x)')
     assert '1 recordings, median: 30 -> 60' in blind_family.time_ratio(old, new, [2])
     assert blind_family.time_ratio(old, new, [7]) == 'no recording in both runs'
+
+
+def test_the_blocked_tally_splits_findings_by_whether_they_are_effects():
+    rows = [{'effects': ['dead_time'], 'found': ['dead_time'], 'blocked': [[3, 0]],
+             'unconfirmed': []},
+            {'effects': ['creep', 'gain_drift'], 'found': ['gain_drift', 'sensor_lag'],
+             'blocked': [[2, 1], [3, 1]], 'unconfirmed': ['creep']},
+            {'effects': [], 'found': [], 'blocked': [], 'unconfirmed': ['offset_drift']},
+            {'effects': ['saturation'], 'found': ['saturation'], 'blocked': [[1, 0]]}]
+    text = blind_family.blocked_tally(rows)       # the last row: a run before the rule
+    assert text.startswith('Blocked cross-validation (3 recordings)')
+    assert 'effect of their recording confirmed 2/3' in text
+    assert 'findings: 0: 1, 1: 1)' in text
+    assert 'not an effect not confirmed 1/2' in text
+    assert 'not in these rows' in blind_family.blocked_tally(rows[3:])
