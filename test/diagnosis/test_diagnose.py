@@ -33,6 +33,7 @@ from hyst_id.cli import main
 from hyst_id.compensation.augment import Augmentation
 from hyst_id.compensation.params_file import read_compensator_params
 from hyst_id.diagnosis import diagnose, DiagnoseSettings
+from hyst_id.diagnosis.blocked_cv import BlockedCV
 from hyst_id.diagnosis.locate import locate, noise_std
 from hyst_id.diagnosis.mechanisms import Context, get_mechanisms, MECHANISM_IDS, MECHANISMS
 from hyst_id.diagnosis.mechanisms.base import COMPENSATION_KINDS
@@ -395,3 +396,30 @@ def test_cli_writes_json_and_figure(tmp_path, capsys):
     back = read_compensator_params(params)
     assert Augmentation.from_mapping(back).offset_rate_per_s == pytest.approx(rate)
     assert doc['compensator']['applied'][0]['mechanism'] == 'offset_drift'
+
+
+def test_a_finding_the_time_blocks_do_not_hold_up_is_stated_not_claimed(monkeypatch):
+    """The verdict rule end to end: the only finding not confirmed -> ``unknown``.
+
+    No simulated record makes the split accept a block that blocked
+    cross-validation then refuses with a margin that survives round-off (the
+    blind family's cases move with it, docs/diagnosis.md), so the time blocks'
+    verdict is set here: the block worse in 3 of 4 quarters, better in none.
+    The rest is the diagnosis's own (the delayed record of ``delay_diagnosis``).
+    """
+    def against(self, before, after):
+        return {'blocks': 4, 'better': 0, 'worse': 3, 'er_a_percent': [1.0] * 4,
+                'er_b_percent': [2.0] * 4, 'n_extrapolated': [0] * 4, 'n_unswept': [0] * 4,
+                'z_min': 4.0}
+
+    monkeypatch.setattr(BlockedCV, 'confirm', against)
+    d = diagnose(synthetic('dead_time', seed=4), settings=FAST)
+    assert d.verdict == 'unknown' and [f.mechanism for f in d.findings] == ['dead_time']
+    assert d.final is not d.baseline                 # the block stays in the fitted model
+    level, message, values = d.status()
+    assert level == 'warn' and values['not_confirmed'] == 'dead_time'
+    text = d.report()
+    assert 'verdict: unknown - the blocks below predict the held-out part' in text
+    assert 'not confirmed (1): dead_time' in text
+    doc = d.to_dict()
+    assert doc['verdict'] == 'unknown' and doc['findings'][0]['blocked_cv']['worse'] == 3
