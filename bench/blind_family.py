@@ -60,6 +60,7 @@ from __future__ import annotations
 import argparse
 from collections import Counter
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+import functools
 import hashlib
 import inspect
 import json
@@ -361,11 +362,14 @@ def finished_rows(code: str, partial: Path = PARTIAL) -> list[dict]:
 
 
 def run_parts(indices: list[int], workers: int, stop_after_s: float, keep: bool, *,
-              partial: Path = PARTIAL, one=None, code: str | None = None) -> list[dict]:
+              partial: Path = PARTIAL, one=None, code: str | None = None,
+              inline: bool = False) -> list[dict]:
     """Diagnose ``indices`` in ``workers`` processes; append each row to ``partial``.
 
     ``one`` (default :func:`run`) makes a row from an index; ``code`` (default
-    :func:`code_hash`) marks the rows this code makes.
+    :func:`code_hash`) marks the rows this code makes. ``inline``: one
+    recording after the other in this process (``workers`` unused; for
+    ``--diagnose-workers``, whose diagnoses start their own processes).
     """
     one = run if one is None else one
     code = code_hash() if code is None else code
@@ -376,6 +380,20 @@ def run_parts(indices: list[int], workers: int, stop_after_s: float, keep: bool,
         print(f'{len(done)} recordings from earlier parts on this code ({code}); '
               f'{len(todo)} to go')
     t0 = time.time()
+
+    def record(r: dict) -> None:
+        rows.append(r)
+        if keep:
+            with partial.open('a') as f:
+                f.write(json.dumps(dict(r, code=code)) + '\n')
+        _say(r, len(rows), len(indices), t0)
+
+    if inline:
+        for i in todo:
+            if time.time() - t0 >= stop_after_s:
+                break
+            record(one(i))
+        return sorted(rows, key=lambda r: r['index'])
     with ProcessPoolExecutor(workers) as pool:
         running: set = set()
         while todo or running:
@@ -385,12 +403,7 @@ def run_parts(indices: list[int], workers: int, stop_after_s: float, keep: bool,
                 break
             finished, running = wait(running, return_when=FIRST_COMPLETED)
             for fut in finished:
-                r = fut.result()
-                rows.append(r)
-                if keep:
-                    with partial.open('a') as f:
-                        f.write(json.dumps(dict(r, code=code)) + '\n')
-                _say(r, len(rows), len(indices), t0)
+                record(fut.result())
     return sorted(rows, key=lambda r: r['index'])
 
 
@@ -460,11 +473,10 @@ def main() -> int:
     full = not (args.no_write or args.indices)
     if k <= 1:
         rows = run_parts(indices, args.workers, 60.0 * args.stop_after_min, keep=full)
-    else:
-        rows, t0 = [], time.time()
-        for i in indices:
-            rows.append(run(i, k))
-            _say(rows[-1], len(rows), len(indices), t0)
+    else:           # the rows of such a run are marked apart: their seconds mean another thing
+        rows = run_parts(indices, 1, 60.0 * args.stop_after_min, keep=full,
+                         one=functools.partial(run, workers=k), code=f'{code_hash()}-k{k}',
+                         inline=True)
     if len(rows) < len(indices):
         print(f'stopped after {len(rows)}/{len(indices)} recordings; run again to go on')
         return 0
@@ -475,7 +487,8 @@ def main() -> int:
             [{key: v for key, v in r.items() if key != 'code'} for r in rows], indent=1))
         (ROOT / 'docs' / 'diagnosis_blind.md').write_text(
             '# Blind diagnosis on the reference family (issue 14)\n\nWritten by '
-            f'`python bench/blind_family.py --n {args.n}`; see the docstring of the script '
+            f'`python bench/blind_family.py --n {args.n}'
+            + (f' --diagnose-workers {k}' if k > 1 else '') + '`; see the docstring of the script '
             'for the family.\n\n' + text + '\n')
         PARTIAL.unlink(missing_ok=True)
     return 0

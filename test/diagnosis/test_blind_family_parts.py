@@ -82,6 +82,13 @@ def test_a_run_in_parts_goes_on_from_rows_of_the_same_code_only(tmp_path):
     assert blind_family.run_parts([5], 1, float('inf'), False, partial=tmp_path / 'no.jsonl',
                                   one=fake_row, code='B')[0]['index'] == 5
     assert not (tmp_path / 'no.jsonl').exists()           # keep=False writes nothing
+    inline = tmp_path / 'inline.jsonl'          # --diagnose-workers: in this process
+    assert blind_family.run_parts([3, 4], 1, 0.0, True, partial=inline, one=fake_row,
+                                  code='C', inline=True) == []
+    assert [r['index'] for r in blind_family.run_parts(
+        [4, 3], 1, float('inf'), True, partial=inline, one=fake_row, code='C',
+        inline=True)] == [3, 4]
+    assert len(inline.read_text().splitlines()) == 2
 
 
 def test_the_time_line_compares_the_same_recordings_only():
