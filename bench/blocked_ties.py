@@ -21,9 +21,14 @@ and prints the runner-up against the winner: the time blocks where it predicts
 better and worse, and the %e_r of each per block. The diagnosis itself is
 unchanged (the round's choice is observed, not altered).
 
+A round that accepts nothing is shown too: every candidate against the
+current model per time block (``--no-winner``: would the time blocks accept a
+block the split refused? Measured on #3 and #138, docs/diagnosis.md).
+
 Run from the repository root (about a minute per recording on 2 cores)::
 
     python bench/blocked_ties.py 106 61 18 93
+    python bench/blocked_ties.py 3 138 --no-winner
 """
 
 from __future__ import annotations
@@ -45,10 +50,36 @@ from hyst_id.diagnosis.select import choose, close_calls  # noqa: E402
 from hyst_id.io.recording import Recording  # noqa: E402
 
 
+_CURRENT: dict = {}
+_try_all = driver.try_all
+
+
+def _observed_try_all(cands, current, data, *args, **kwargs):
+    """:func:`try_all`, keeping the model the round starts from."""
+    _CURRENT['fit'] = current
+    return _try_all(cands, current, data, *args, **kwargs)
+
+
+def _no_winner(comps, data) -> None:
+    """Every candidate of a round that accepted none against the current model, per block."""
+    current = _CURRENT['fit']
+    print(f'  round without a winner (current: {"+".join(current.ids) or "baseline"})',
+          flush=True)
+    pc = block_predictions(current, data)
+    for c in comps:
+        cv = compare_blocked(pc, block_predictions(c.fit, data), data)
+        print(f'    {c.mechanism} ({c.status}): better than the current model in '
+              f'{cv.better}, worse in {cv.worse} of {cv.n_blocks} blocks; %e_r per block '
+              f'current {[round(x, 3) for x in cv.er_a_percent]}, {c.mechanism} '
+              f'{[round(x, 3) for x in cv.er_b_percent]}', flush=True)
+
+
 def _observed_choose(comps, data, criteria):
     """:func:`choose`, printing the blocked cross-validation of its ties."""
     winner, tied = choose(comps, data, criteria)
     if winner is None:
+        if _CURRENT.get('no_winner'):
+            _no_winner(comps, data)
         return winner, tied
     close = [c for c in close_calls(comps, winner, tied, data, criteria) if c not in tied]
     print(f'  round winner {winner.mechanism} (judged held-out '
@@ -69,8 +100,12 @@ def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument('indices', type=int, nargs='+', help='blind-family recordings')
     ap.add_argument('--workers', type=int, default=2)
+    ap.add_argument('--no-winner', action='store_true',
+                    help='also show the rounds that accept no block')
     args = ap.parse_args()
     driver.choose = _observed_choose
+    driver.try_all = _observed_try_all
+    _CURRENT['no_winner'] = args.no_winner
     for i in args.indices:
         case = blind_family.draw(i)
         print(f'#{i} {case["channel"]}: {"+".join(case["effects"]) or "clean"}', flush=True)
