@@ -29,6 +29,7 @@ Run from the repository root (about a minute per recording on 2 cores)::
 
     python bench/blocked_ties.py 106 61 18 93
     python bench/blocked_ties.py 3 138 --no-winner
+    python bench/blocked_ties.py --short-splits 150     # which splits are short
 """
 
 from __future__ import annotations
@@ -44,10 +45,12 @@ sys.path.insert(0, str(ROOT))
 import blind_family  # noqa: E402, I100
 
 from hyst_id.diagnosis import diagnose, DiagnoseSettings  # noqa: E402
-from hyst_id.diagnosis.blocked_cv import block_predictions, compare_blocked  # noqa: E402
+from hyst_id.diagnosis.blocked_cv import (  # noqa: E402
+    block_predictions, compare_blocked, SPLIT_MINORITY)
 import hyst_id.diagnosis.driver as driver  # noqa: E402, I100
 from hyst_id.diagnosis.select import choose, close_calls  # noqa: E402
 from hyst_id.io.recording import Recording  # noqa: E402
+from hyst_id.signals.split import inside_rows, split_index  # noqa: E402
 
 
 _CURRENT: dict = {}
@@ -71,7 +74,23 @@ def _no_winner(comps, data) -> None:
         print(f'    {c.mechanism} ({c.status}): better than the current model in '
               f'{cv.better}, worse in {cv.worse} of {cv.n_blocks} blocks; %e_r per block '
               f'current {[round(x, 3) for x in cv.er_a_percent]}, {c.mechanism} '
-              f'{[round(x, 3) for x in cv.er_b_percent]}', flush=True)
+              f'{[round(x, 3) for x in cv.er_b_percent]}; noise floor '
+              f'{[round(x, 3) for x in cv.floor_percent]}', flush=True)
+
+
+def short_splits(n: int) -> list[int]:
+    """The family's recordings whose split judges under ``SPLIT_MINORITY`` of its held-out part."""
+    out = []
+    for i in range(n):
+        case = blind_family.draw(i)
+        n_train = split_index(case['t'], DiagnoseSettings().train_fraction)
+        judged = inside_rows(case['command'], n_train).size
+        if judged < SPLIT_MINORITY * (case['t'].size - n_train):
+            out.append(i)
+            print(f'#{i} {case["channel"]}, {case["excitation"]}: '
+                  f'{"+".join(case["effects"]) or "clean"}; judged {judged} of '
+                  f'{case["t"].size - n_train} held-out samples', flush=True)
+    return out
 
 
 def _observed_choose(comps, data, criteria):
@@ -98,11 +117,17 @@ def _observed_choose(comps, data, criteria):
 def main() -> int:
     """Diagnose the recordings given, printing each round's ties per time block."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument('indices', type=int, nargs='+', help='blind-family recordings')
+    ap.add_argument('indices', type=int, nargs='*', help='blind-family recordings')
+    ap.add_argument('--short-splits', type=int, metavar='N',
+                    help='only list the first N recordings whose split judges under half of '
+                         'its held-out part (no diagnosis)')
     ap.add_argument('--workers', type=int, default=2)
     ap.add_argument('--no-winner', action='store_true',
                     help='also show the rounds that accept no block')
     args = ap.parse_args()
+    if args.short_splits:
+        print(' '.join(map(str, short_splits(args.short_splits))))
+        return 0
     driver.choose = _observed_choose
     driver.try_all = _observed_try_all
     _CURRENT['no_winner'] = args.no_winner

@@ -71,6 +71,18 @@ def main() -> int:
                   f'-> {f.er_holdout_after_percent:.3g}); blocked CV better {cv["better"]}, '
                   f'worse {cv["worse"]} of {cv["blocks"]}'
                   + ('' if confirmed(cv) else ': not confirmed'))
+            for a in f.alternatives:      # judgement calls, and why the finding was chosen
+                line = (f'    {a["kind"]} {a["mechanism"]}: judged held-out '
+                        f'{a.get("er_judged_after_percent", float("nan")):.3g}, all held-out '
+                        f'{a.get("er_holdout_after_percent", float("nan")):.3g}')
+                if a['kind'] == 'split':
+                    b = a['blocked_cv']
+                    line += (f' (the split judged {a["n_judged"]} of {a["n_holdout"]}; '
+                             f'{f.mechanism} judged {a["er_judged_chosen_percent"]:.3g}; per '
+                             f'block %e_r {a["mechanism"]} '
+                             f'{[round(x, 2) for x in b["er_a_percent"]]}, {f.mechanism} '
+                             f'{[round(x, 2) for x in b["er_b_percent"]]})')
+                print(line)
         try:
             model, aug, _ = compensator_set(d)
             print(f'  compensator set ({model.family}): in-line {aug.describe()}')

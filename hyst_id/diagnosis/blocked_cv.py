@@ -47,7 +47,11 @@ is the lower.
 What it can and cannot say (``docs/diagnosis.md``, "Blocked cross-validation"):
 a block that is the missing physics is better in every time block; so is a
 block that fills a gap the baseline's chain leaves, so it does not separate
-the two, and it confirms the single split's claims rather than deciding ties.
+the two. It confirms the single split's claims (:meth:`BlockedCV.confirm`)
+and decides a round only where the split judged too little
+(:data:`SPLIT_MINORITY`, :meth:`BlockedCV.decide`): between tied blocks on a
+split that judges most of its held-out part it was right once and wrong
+twice (``bench/blocked_ties.py``), so there the split decides.
 """
 
 from __future__ import annotations

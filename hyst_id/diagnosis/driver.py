@@ -25,7 +25,9 @@
 3. inserts every mechanism of the library (:mod:`hyst_id.diagnosis.mechanisms`)
    at its place in the chain, refits locally from the baseline (in worker
    processes when ``settings.workers`` is not 1: :mod:`hyst_id.diagnosis.trial`)
-   and keeps the best one the data support (:mod:`hyst_id.diagnosis.select`)
+   and keeps the best one the data support (:mod:`hyst_id.diagnosis.select`;
+   time blocks decide when the split judges too little:
+   :meth:`~hyst_id.diagnosis.blocked_cv.BlockedCV.decide`)
    and that more than the chain's refit alone explains
    (:mod:`hyst_id.diagnosis.control`); when none is accepted but a chain as
    good on the training part predicts the held-out part better, that chain is
@@ -252,22 +254,15 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
                  and getattr(m, 'swap_family', '') != family]
         comps = try_all(cands, current, data, ctx, settings, loc, chain_starts,
                         lambda text: say(f'round {round_no + 1}: {text}'))
-        winner, tied = choose(comps, data, settings.criteria)
+        rsay = (lambda text, k=round_no + 1: say(f'round {k}: {text}'))
+        winner, alternatives = _choose(comps, data, settings.criteria, blocked, rsay)
         null = None if winner is None else null_control(
             winner, current, data, max_nfev=2 * settings.fit_budget)
         if null is not None and recheck(comps, null, data, settings.criteria):
-            say(f"round {round_no + 1}: {winner.mechanism} was the chain refit's doing")
+            rsay(f"{winner.mechanism} was the chain refit's doing")
             current = null
             loc = locate(t, v_orig, y, current.prediction, sigma, n_train, ctx.period_s)
-            winner, tied = choose(comps, data, settings.criteria)
-        split = None
-        if winner is not None:
-            split = winner
-            winner, split_cv = blocked.decide(winner, tied + close_calls(
-                comps, winner, tied, data, settings.criteria))
-            if winner is not split:
-                say(f'round {round_no + 1}: {winner.mechanism} predicts every time block '
-                    f'better than {split.mechanism}, which led on the short judged split')
+            winner, alternatives = _choose(comps, data, settings.criteria, blocked, rsay)
         rounds.append(round_record(round_no + 1, comps, winner, data))
         if winner is None and not rechosen:
             other = equivalent_chain(comps, current, data, settings.criteria,
@@ -282,27 +277,26 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
         if winner is None:
             break
         mech = next(m for m in mechs if m.id == winner.mechanism)
-        alternatives = alternatives_record(
-            tied, close_calls(comps, winner, tied, data, settings.criteria), data)
-        if winner is not split:     # decided by blocked cross-validation: the split's winner
-            alternatives = [split_record(split, winner, data, split_cv)]
         named = {a['mechanism'] for a in alternatives}
         calls = hold_calls(winner, comps, data, settings.criteria, ctx.dt_s)
         alternatives += [a for a in calls if a['mechanism'] not in named]
         first, trained = winner, winner.fit.er_train_percent
+        by = 'time blocks' if blocked.split_short else 'judged split'
         winner, contested = contest(winner, comps, data, ctx, spec, settings,
                                     floor_train_percent=floor_t,
                                     beats=blocked.beats if blocked.split_short else None,
-                                    say=lambda text: say(f'round {round_no + 1}: {text}'))
+                                    say=rsay)
         if winner is not first:
             mech = next(m for m in mechs if m.id == winner.mechanism)
             # the round's ties and close calls were measured against the former leader
-            alternatives = [{'mechanism': first.mechanism, 'kind': 'contested',
+            alternatives = [{'mechanism': first.mechanism, 'kind': 'contested', 'by': by,
                              'er_holdout_after_percent': first.fit.er_holdout_percent,
-                             'er_judged_after_percent': contested[0]['er_judged_after_percent']}]
-            say(f'round {round_no + 1}: {winner.mechanism} takes the round from '
-                f'{first.mechanism} once both chains are re-identified')
-            chain_notes.append(_contest_note(round_no + 1, first, winner, contested))
+                             'er_judged_after_percent': contested[0]['er_judged_after_percent']}
+                            ] + [a for a in alternatives if a['kind'] == 'split'
+                                 and a['mechanism'] != winner.mechanism]
+            rsay(f'{winner.mechanism} takes the round from {first.mechanism} once both chains '
+                 'are re-identified')
+            chain_notes.append(_contest_note(round_no + 1, first, winner, contested, by))
         elif winner.fit.er_train_percent != trained:
             say(f're-identified the chain with {winner.mechanism}: training %e_r '
                 f'{trained:.4g} -> {winner.fit.er_train_percent:.4g}')
@@ -406,12 +400,36 @@ def _rechosen_note(before: FitResult, after: FitResult, data: Data) -> str:
 
 
 def _contest_note(round_no: int, first: Comparison, chosen: Comparison,
-                  contested: list[dict]) -> str:
+                  contested: list[dict], by: str = 'judged split') -> str:
     figures = ', '.join(f"{c['mechanism']} {c['er_judged_after_percent']:.4g}" for c in contested)
+    how = ('predicts the judged held-out part clearly better' if by == 'judged split' else
+           'predicts every judged time block better (the split judged too little to decide)')
     return (f'round {round_no}: {first.mechanism} led on fits made around the current chain, '
-            f"but with each block's chain re-identified {chosen.mechanism} predicts the judged "
-            f'held-out part clearly better (judged %e_r after re-identification: {figures}); '
-            f'the current chain was biased by the missing effect')
+            f"but with each block's chain re-identified {chosen.mechanism} {how} (judged "
+            f'%e_r after re-identification: {figures}); the current chain was biased by the '
+            'missing effect')
+
+
+def _choose(comps: list[Comparison], data: Data, criteria, blocked: BlockedCV,
+            say: Callable[[str], None]) -> tuple[Comparison | None, list[dict]]:
+    """:func:`choose`, then, on a short split, :meth:`BlockedCV.decide` among its rivals.
+
+    Returns the round's winner (None when nothing is accepted) and its
+    alternatives record: the tied candidates and close calls, or, when the
+    time blocks overruled the split, the split's own choice (kind ``split``;
+    the others were tied or close to that choice on the short split, which
+    said too little to rank them against the winner).
+    """
+    winner, tied = choose(comps, data, criteria)
+    if winner is None:
+        return None, []
+    close = close_calls(comps, winner, tied, data, criteria)
+    chosen, cv = blocked.decide(winner, tied + close)
+    if chosen is winner:
+        return winner, alternatives_record(tied, close, data)
+    say(f'{chosen.mechanism} predicts every time block better than {winner.mechanism}, the '
+        "short judged split's choice")
+    return chosen, [split_record(winner, chosen, data, cv)]
 
 
 def _refresh_values(findings: list[Finding], mechs: list[Mechanism], final: FitResult,

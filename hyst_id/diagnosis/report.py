@@ -41,21 +41,28 @@ def _alternative_lines(f: Any) -> list[str]:
     tied = [a for a in f.alternatives if a.get('kind', 'tied') == 'tied']
     close = [a for a in f.alternatives if a.get('kind') == 'close']
     for a in f.alternatives:
-        if a.get('kind') == 'contested':
+        if a.get('kind') == 'contested' and a.get('by') == 'time blocks':
+            lines.append(f'    {a["mechanism"]} led on fits around the earlier chain; '
+                         f're-identified with each block, {f.mechanism} predicts every judged '
+                         'time block better (the split judged too little to decide; judged '
+                         f'{_fmt(a["er_judged_after_percent"])} for {a["mechanism"]})')
+        elif a.get('kind') == 'contested':
             lines.append(f'    {a["mechanism"]} led on fits around the earlier chain; '
                          f're-identified with each block, {f.mechanism} predicts the held-out '
                          'part better '
                          f'(judged {_fmt(a["er_judged_after_percent"])} for {a["mechanism"]})')
         if a.get('kind') == 'split':
             cv = a['blocked_cv']
-            lines.append(f'    a judgement call: {a["mechanism"]} led on the judged held-out '
-                         f'samples (%e_r {_fmt(a["er_judged_after_percent"])} against '
-                         f'{_fmt(a["er_judged_chosen_percent"])}), but the split judged only '
+            lines.append(f'    a judgement call: {a["mechanism"]} was the choice of the judged '
+                         f'held-out samples (%e_r {_fmt(a["er_judged_after_percent"])}, '
+                         f'{_fmt(a["er_judged_chosen_percent"])} for {f.mechanism} before '
+                         're-identification), but the split judged only '
                          f'{a["n_judged"]} of {a["n_holdout"]} (the command then leaves the '
                          f'training range); refitted per time block, {f.mechanism} predicts '
-                         f'all {cv["blocks"]} judged blocks better (held-out '
-                         f'{_fmt(f.er_holdout_after_percent)} against '
-                         f'{_fmt(a["er_holdout_after_percent"])} on all held-out samples)')
+                         f'all {cv["blocks"]} judged blocks better (%e_r per block '
+                         + ', '.join(f'{_fmt(b)} against {_fmt(x)}' for x, b in zip(
+                             cv['er_a_percent'], cv['er_b_percent'])
+                             if b is not None and np.isfinite(b)) + ')')
     if tied:
         lines.append('    also consistent with the data (tied, decided by training BIC '
                      f'and evidence): {_alts(tied)}')

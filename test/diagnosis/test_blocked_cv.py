@@ -198,7 +198,8 @@ def test_time_blocks_decide_a_round_only_when_the_split_judged_too_little():
     finding = SimpleNamespace(mechanism='dead_time', alternatives=[alt],
                               er_holdout_after_percent=right.fit.er_holdout_percent)
     line, = _alternative_lines(finding)
-    assert 'a judgement call: creep led on the judged held-out samples' in line
+    assert 'a judgement call: creep was the choice of the judged held-out samples' in line
+    assert line.count(' against ') == 3          # the three judged quarters' %e_r
     assert 'the split judged only 60 of 720' in line
     assert 'dead_time predicts all 3 judged blocks better' in line
     from hyst_id.io.jsonable import jsonable

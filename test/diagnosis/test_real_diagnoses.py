@@ -54,6 +54,7 @@ def _bh_loops(path: Path) -> Recording:
     return Recording(np.arange(h.size, dtype=float), h, b, 'position', 'A/m', 'T', path.name)
 
 
+@pytest.mark.slow
 def test_steel_loops_are_named_curved_branches_not_creep():
     rec = _bh_loops(DATA / 'magnetic-bh-loops' / 'M130_27s_steel.csv')
     d = diagnose(rec, settings=DiagnoseSettings(workers=1))
@@ -62,3 +63,8 @@ def test_steel_loops_are_named_curved_branches_not_creep():
     assert confirmed(first.blocked_cv) and first.blocked_cv['worse'] == 0
     assert first.er_holdout_after_percent < 0.6 * d.baseline.er_holdout_percent
     assert 'creep' not in [f.mechanism for f in d.findings]
+    # the short split chose otherwise; the time blocks decided, and the report says so
+    split, = [a for a in first.alternatives if a['kind'] == 'split']
+    assert split['mechanism'] != 'loop_shape' and split['n_judged'] < 0.5 * split['n_holdout']
+    assert split['blocked_cv']['better'] == split['blocked_cv']['blocks'] >= 2
+    assert f"{split['mechanism']} was the choice of the judged held-out samples" in d.report()
