@@ -25,6 +25,7 @@ and each finding's blocked cross-validation (time blocks better / worse).
 Usage (from the repository root; a few minutes in all)::
 
     python bench/real_diagnoses.py [--data ../shared/data] [--only Circle_1bar]
+    python bench/real_diagnoses.py --figures docs/figures    # the docs' figures too
 """
 
 from __future__ import annotations
@@ -43,6 +44,7 @@ from real_recordings import load_all  # noqa: E402, I100
 from hyst_id.diagnosis import diagnose  # noqa: E402, I100
 from hyst_id.diagnosis.blocked_cv import confirmed  # noqa: E402
 from hyst_id.diagnosis.export import compensator_set  # noqa: E402
+from hyst_id.diagnosis.report import plot_diagnosis  # noqa: E402
 from hyst_id.errors import HystIdError  # noqa: E402
 
 
@@ -55,6 +57,8 @@ def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument('--data', default=str(ROOT.parent / 'shared' / 'data'))
     ap.add_argument('--only', default='', help='substring of the recordings to run')
+    ap.add_argument('--figures', metavar='DIR',
+                    help="write each diagnosis's figure as DIR/real_<file>.png (docs/figures)")
     args = ap.parse_args()
     for rec in load_all(Path(args.data)):
         if args.only and args.only not in rec.source:
@@ -94,6 +98,10 @@ def main() -> int:
               f'{d.extra["hold"] or "-"}')
         for note in d.notes:
             print(f'  note: {note}')
+        if args.figures:
+            name = Path(rec.source).stem
+            path = plot_diagnosis(d, Path(args.figures) / f'real_{name}.png', dpi=72)
+            print(f'  figure: {path}')
     return 0
 
 

@@ -271,7 +271,7 @@ def format_diagnosis(d: Any) -> str:
     return '\n'.join(lines)
 
 
-def plot_diagnosis(d: Any, path: str | Path) -> Path:
+def plot_diagnosis(d: Any, path: str | Path, *, dpi: int = 110) -> Path:
     """Figure: measured vs baseline vs augmented, residuals with the located regions, ACF.
 
     Parameters
@@ -280,6 +280,8 @@ def plot_diagnosis(d: Any, path: str | Path) -> Path:
         The diagnosis to draw.
     path : str or pathlib.Path
         PNG file to write (a directory gets ``diagnosis_<channel>.png``).
+    dpi : int
+        Resolution of the PNG (the docs' figures use less).
 
     Returns
     -------
@@ -348,6 +350,6 @@ def plot_diagnosis(d: Any, path: str | Path) -> Path:
     a.set_title('residual autocorrelation')
     a.legend(loc='best', fontsize=7)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    fig.savefig(path, dpi=dpi)
     plt.close(fig)
     return path

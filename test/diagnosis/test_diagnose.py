@@ -266,6 +266,8 @@ def test_report_and_figure(delay_diagnosis, clean_diagnosis, tmp_path):
     assert 'verdict: none' in clean_diagnosis.report()
     path = plot_diagnosis(delay_diagnosis, tmp_path / 'fig.png')
     assert path.stat().st_size > 10_000
+    small = plot_diagnosis(delay_diagnosis, tmp_path / 'small.png', dpi=72)   # the docs'
+    assert 5_000 < small.stat().st_size < path.stat().st_size
 
 
 def test_locate_white_noise_is_white_and_a_delay_is_not():
