@@ -292,8 +292,9 @@ class BlockedCV:
         chosen, best, key = winner, {}, np.inf
         for c in rivals:
             v = self.beats(winner.fit, c.fit)
-            if v is not None and float(np.nansum(v.er_b_percent)) < key:
-                chosen, best, key = c, v.to_dict(), float(np.nansum(v.er_b_percent))
+            total = np.inf if v is None else float(np.nansum(v.er_b_percent))
+            if total < key:
+                chosen, best, key = c, v.to_dict(), total
         if chosen is not winner:
             best.update(over=winner.mechanism, z_min=self.z_min)
         return chosen, best

@@ -252,9 +252,8 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
         cands = [m for m in mechs if m.id not in done
                  and (m.families is None or family in m.families)
                  and getattr(m, 'swap_family', '') != family]
-        comps = try_all(cands, current, data, ctx, settings, loc, chain_starts,
-                        lambda text: say(f'round {round_no + 1}: {text}'))
         rsay = (lambda text, k=round_no + 1: say(f'round {k}: {text}'))
+        comps = try_all(cands, current, data, ctx, settings, loc, chain_starts, rsay)
         winner, alternatives = _choose(comps, data, settings.criteria, blocked, rsay)
         null = None if winner is None else null_control(
             winner, current, data, max_nfev=2 * settings.fit_budget)
