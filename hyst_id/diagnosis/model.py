@@ -196,16 +196,23 @@ class ComposedModel:
             if m.stage == 'position':
                 x = m.position(th[m.id], x, span)
         basis = [x]
+        terms: list[np.ndarray] = []
+        term_labels: list[str] = []
         for m in self.mechanisms:
             if m.stage == 'quantity':
                 b = m.quantity(th[m.id], x, span)
                 if b is not None:
                     basis = b
-        basis = [self._sensor(x_chain, t_s, b) for b in basis]
+                own = m.quantity_terms(th[m.id], x, span)
+                terms += own
+                term_labels += [f'{m.id}:{i}' for i in range(len(own))]
+        n_basis = len(basis)
+        basis = [self._sensor(x_chain, t_s, b) for b in basis + terms]
         for m in self.mechanisms:
             if m.stage == 'sensor':
                 basis = [m.sensor(th[m.id], t_s, held(b, self.hold)) for b in basis]
-        labels = ['sensor'] + [f'quantity:{i}' for i in range(1, len(basis))] + ['offset']
+        labels = (['sensor'] + [f'quantity:{i}' for i in range(1, n_basis)] + term_labels
+                  + ['offset'])
         columns = basis + [np.ones_like(t_s)]
         for m in self.mechanisms:
             if m.stage == 'output':

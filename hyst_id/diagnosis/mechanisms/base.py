@@ -231,6 +231,17 @@ class Mechanism:
         """Basis of the sensed quantity as a function of position (``None``: ``[x]``)."""
         return None
 
+    def quantity_terms(self, theta: np.ndarray, x: np.ndarray, span: tuple[float, float]
+                       ) -> list[np.ndarray]:
+        """Terms added to the sensed quantity, each with its own linear coefficient.
+
+        They pass through the sensor like the quantity itself and are labelled
+        ``'<id>:<i>'`` after the quantity's basis (default: none). A force
+        that depends on the path of the position, not on its value (friction),
+        is one: it is no function of ``x`` that :meth:`quantity` could give.
+        """
+        return []
+
     def sensor(self, theta: np.ndarray, t_s: np.ndarray, s: np.ndarray) -> np.ndarray:
         """Extra sensor dynamics after the modelled ones."""
         return s

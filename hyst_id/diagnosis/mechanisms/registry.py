@@ -25,6 +25,7 @@ from hyst_id.diagnosis.mechanisms import (
     actuator_dynamics,
     creep,
     dead_time,
+    friction,
     gain_drift,
     loop_shape,
     offset_drift,
@@ -44,7 +45,7 @@ __all__ = ['MECHANISMS', 'MECHANISM_IDS', 'Context', 'Mechanism', 'Quantity', 'g
 MECHANISMS: dict[str, Mechanism] = {m.MECHANISM.id: m.MECHANISM for m in (
     dead_time, sensor_lag, supply_decay, offset_drift, saturation, stiction,
     static_nonlinearity, rate_dependence, loop_shape, gain_drift, creep,
-    actuator_dynamics)}
+    actuator_dynamics, friction)}
 
 #: The ids alone.
 MECHANISM_IDS = tuple(MECHANISMS)
