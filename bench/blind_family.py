@@ -24,6 +24,9 @@ barely visible to strong:
 * on the travel: ``saturation`` (an end stop cutting 2-25 % of the travel's top),
   ``static_nonlinearity`` (a quadratic term, 1-20 % of the span),
   ``actuator_dynamics`` (zeta 0.1-0.5, omega_n dt 0.05-0.5);
+* on the travel from #150 on (:data:`FRICTION_FROM`): ``friction``, a force band leading
+  the motion (1-20 % of the span, Dahl's state by Euler steps with a presliding travel
+  of 0.5-10 % of it), alone or with the first effect drawn; #0-149 are as before;
 * after the channel's sensor: ``sensor_lag`` (tau 0.5-20 samples), ``creep``
   (a 2-20 % share relaxing with tau 2-20 % of the record), ``gain_drift`` (0.5-15 %
   over the record), ``offset_drift`` (0.2-10 % of the span over the record).
@@ -83,6 +86,21 @@ from reference_sim import simulate as reference_simulate  # noqa: E402, I100
 N_SAMPLES = 2000
 EFFECTS = ('dead_time', 'saturation', 'static_nonlinearity', 'actuator_dynamics',
            'sensor_lag', 'creep', 'gain_drift', 'offset_drift')
+#: Recordings from this index on carry ``friction`` (joined the library after the first
+#: 150 were drawn; those stay as they were), alone or with the first effect drawn.
+FRICTION_FROM = 150
+
+
+def euler_dahl(x: np.ndarray, length: float, substeps: int = 50) -> np.ndarray:
+    """Dahl's friction state ``dz/dx = (1 - z sign(dx)) / length`` by small Euler steps."""
+    z = np.zeros(x.size)
+    zk = 0.0
+    for k in range(1, x.size):
+        dx = (x[k] - x[k - 1]) / substeps
+        for _ in range(substeps):
+            zk = min(1.0, max(-1.0, zk + dx / length * (1.0 - zk * np.sign(dx))))
+        z[k] = zk
+    return z
 
 
 def _logu(rng: np.random.Generator, lo: float, hi: float) -> float:
@@ -94,7 +112,10 @@ def draw(index: int) -> dict:
     rng = np.random.default_rng([index, 14])
     channel = ('position', 'pressure')[index % 2]
     n_eff = int(rng.choice([0, 1, 2], p=[0.25, 0.5, 0.25]))
-    effects = sorted(rng.choice(EFFECTS, size=n_eff, replace=False).tolist())
+    effects = rng.choice(EFFECTS, size=n_eff, replace=False).tolist()
+    if index >= FRICTION_FROM:
+        effects = ['friction'] + effects[:1]
+    effects = sorted(effects)
     dt = float(rng.choice([0.01, 0.02, 0.05, 0.1]))
     t = np.arange(N_SAMPLES) * dt
     kind = (*EXCITATIONS, 'moves and holds')[int(rng.integers(0, len(EXCITATIONS) + 1))]
@@ -121,6 +142,11 @@ def draw(index: int) -> dict:
         mags['static_nonlinearity'] = c
         z = (x - float(np.min(x))) / span
         x = x + c * span * z ** 2
+    if 'friction' in effects:         # a force with the motion: 1-20 % of the span
+        frng = np.random.default_rng([index, 14, 1])
+        force, length = _logu(frng, 0.01, 0.2), _logu(frng, 0.005, 0.1)
+        mags['friction'] = force
+        x = x + force * span * euler_dahl(x, length * span)
     if 'actuator_dynamics' in effects:
         zeta, wdt = rng.uniform(0.1, 0.5), _logu(rng, 0.05, 0.5)
         mags['actuator_dynamics'] = wdt
@@ -244,7 +270,7 @@ def summary(rows: list[dict], how: str = 'one worker each') -> str:
     lines += ['Per effect (recordings that contain it; named = among the findings):', '',
               '| effect | recordings | cost > 3 x | named there | named at cost <= 3 x |',
               '|---|---|---|---|---|']
-    for e in EFFECTS:
+    for e in (*EFFECTS, 'friction'):
         has = [r for r in eff if e in r['effects']]
         hi = [r for r in has if r['cost'] > 3.0]
         lo = [r for r in has if r['cost'] <= 3.0]
