@@ -14,18 +14,19 @@
 
 """``friction``: a force band reversing with the motion (issue 14, item 1).
 
-The recordings are written here in plain numpy, apart from the package: a
-drive moved through a displacement profile reads a force that is a slight
-slope of the displacement plus a Dahl friction force, integrated by explicit
-Euler steps a hundredth of a sample long (the package steps the exact
-exponential solution), as a cylinder moved from outside reads it (the
-shared TU Delft recordings).
+The recordings are made apart from the package: the paper's chain by the
+independent reference simulator (``test/reference_sim``), and on its travel a
+force that leads the motion, Dahl's friction integrated here by explicit Euler
+steps a hundredth of a sample long (the package steps the exact exponential
+solution), as a drive moved through a seal reads it.
 """
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
+
+from reference_sim import backlash, hysteresis
 
 from hyst_id.diagnosis import diagnose, DiagnoseSettings
 from hyst_id.diagnosis.mechanisms.friction import dahl_state
@@ -34,8 +35,11 @@ from hyst_id.io.recording import Recording
 
 SETTINGS = DiagnoseSettings(seeds=(0,), generations=120, max_mechanisms=1, hops=20)
 
-#: The recordings' friction force (N) and presliding displacement (mm).
-FORCE_N, PRESLIDING_MM = 2.0, 0.15
+#: The recordings' friction force (share of the reading's span) and presliding travel
+#: (share of the travel).
+FORCE_SHARE, PRESLIDING_SHARE = 0.08, 0.03
+#: The reading's gain and offset on the travel (um per mA-eq, um).
+GAIN, OFFSET = 25.0, -40.0
 
 
 def euler_dahl(x: np.ndarray, length: float, substeps: int = 100) -> np.ndarray:
@@ -50,16 +54,22 @@ def euler_dahl(x: np.ndarray, length: float, substeps: int = 100) -> np.ndarray:
     return z
 
 
-def friction_recording(seed: int, force_n: float = FORCE_N) -> Recording:
-    """A displacement run (two sines, decaying) and the force it reads, 2,000 samples."""
+def friction_recording(seed: int) -> tuple[Recording, float, float]:
+    """Two decaying sines through the chain, plus the friction force; 2,000 samples.
+
+    Returns the recording, the friction force (um) and the presliding travel (mA-eq).
+    """
     rng = np.random.default_rng(seed)
     t = np.arange(2000) * 0.02
-    period = rng.uniform(6.0, 10.0)
-    x = (5.0 + 4.0 * np.sin(2 * np.pi * t / period) * (1.0 - 0.3 * t / t[-1])
-         + 0.5 * np.sin(2 * np.pi * t / rng.uniform(2.0, 3.0) + rng.uniform(0, 6)))
-    force = 20.0 + 0.3 * x + force_n * euler_dahl(x, PRESLIDING_MM)
-    force = force + rng.normal(0.0, 0.02, t.size)
-    return Recording(t, x, force, 'position', 'mm', 'N', f'friction #{seed}')
+    v = (9.0 + 2.0 * np.sin(2 * np.pi * t / rng.uniform(6.0, 10.0)) * (1.0 - 0.3 * t / t[-1])
+         + 0.3 * np.sin(2 * np.pi * t / rng.uniform(2.0, 3.0) + rng.uniform(0, 6)))
+    x = backlash(hysteresis(v, 1.01, 1.05, 0.10, 0.15, -0.25, 0.50, 14.0, 7.0), 1.0,
+                 -0.15, 0.15)
+    force = FORCE_SHARE * GAIN * np.ptp(x)
+    length = PRESLIDING_SHARE * np.ptp(x)
+    y = GAIN * x + OFFSET + force * euler_dahl(x, length)
+    y = y + rng.normal(0.0, 0.003 * np.ptp(y), t.size)
+    return Recording(t, v, y, 'position', 'mA', 'um', f'friction #{seed}'), force, length
 
 
 def test_dahl_state_is_the_exact_solution_and_rate_independent():
@@ -103,19 +113,51 @@ def test_friction_is_registered_with_words():
 @pytest.mark.slow
 @pytest.mark.parametrize('seed', [0, pytest.param(1, marks=pytest.mark.thorough)])
 def test_a_force_band_with_the_motion_is_friction(seed):
-    """Named with its force and presliding travel, and the held-out error near the floor.
+    """Named with its force and presliding travel, and the held-out error at the floor.
 
-    Measured on seeds 0-5 (with these settings): named 6/6, force 1.987-2.003 N,
-    presliding 0.071-0.147 mm (a turn of 0.15 mm lasts one or two samples at these
-    speeds, so the noise decides much of it), final held-out 1.04-1.47 x the floor.
-    The bounds sit outside that spread.
+    Measured on seeds 0-5 (with these settings): named 6/6, force 0.997-1.004 x the
+    truth, presliding 0.947-0.966 x (the Euler steps of the recording against the
+    exact ones of the block), final held-out 0.91-1.08 x the floor; seeds 0-2 under
+    round-off probes 1 and 2 the same to three digits. The bounds sit outside that.
     """
-    d = diagnose(friction_recording(seed), settings=SETTINGS)
+    rec, force, length = friction_recording(seed)
+    d = diagnose(rec, settings=SETTINGS)
     assert d.verdict == 'friction', d.report()
     values = d.findings[0].params
-    assert values['friction_force'].value == pytest.approx(FORCE_N, rel=0.05)
-    assert values['friction_force'].unit == 'N'
-    assert 0.3 * PRESLIDING_MM < values['presliding'].value < 2.0 * PRESLIDING_MM
+    assert values['friction_force'].value == pytest.approx(force, rel=0.03)
+    assert values['friction_force'].unit == 'um'
+    assert values['presliding'].value == pytest.approx(length, rel=0.15)
     assert values['higher_while_rising'].value == 1.0
+    assert values['leads_motion'].value == 1.0
     assert 'sliding-friction force' in d.findings[0].explanation
-    assert d.final.er_holdout_percent < 1.8 * d.noise_floor_percent, d.report()
+    assert d.final.er_holdout_percent < 1.3 * d.noise_floor_percent, d.report()
+
+
+def flat_friction_recording(seed: int) -> Recording:
+    """A force hardly changing with the displacement, plus friction (a cylinder moved by hand).
+
+    The paper's loop cannot make the straight line under the band exactly (its loop
+    only thins towards it), so the fit of the line is left to the chain's polish.
+    """
+    rng = np.random.default_rng(seed)
+    t = np.arange(2000) * 0.02
+    x = (5.0 + 4.0 * np.sin(2 * np.pi * t / rng.uniform(6.0, 10.0)) * (1.0 - 0.3 * t / t[-1])
+         + 0.5 * np.sin(2 * np.pi * t / rng.uniform(2.0, 3.0) + rng.uniform(0, 6)))
+    force = 20.0 + 0.3 * x + 2.0 * euler_dahl(x, 0.15)
+    return Recording(t, x, force + rng.normal(0.0, 0.02, t.size), 'position', 'mm', 'N',
+                     f'flat friction #{seed}')
+
+
+@pytest.mark.slow
+def test_a_band_on_a_flat_force_is_friction():
+    """Named with its force, in either sense (the reading has no slope to compare with).
+
+    Measured on seeds 0-5 and on seeds 0-1 under round-off probes 1 and 2: named
+    10/10, force 1.973-2.003 N (true 2.0). Where the polish leaves the straight line
+    under the band moves with round-off (final held-out 1.04-1.47 x the floor
+    unperturbed, up to 4.0 x under the probes), so it is not asserted here.
+    """
+    d = diagnose(flat_friction_recording(0), settings=SETTINGS)
+    assert d.verdict == 'friction', d.report()
+    assert d.findings[0].params['friction_force'].value == pytest.approx(2.0, rel=0.03)
+    assert d.findings[0].params['friction_force'].unit == 'N'

@@ -130,14 +130,15 @@ class Friction(Mechanism):
         return np.array([0.03])
 
     def data_starts(self, model, data, p_prev, chain_starts) -> list[np.ndarray]:
-        """Thin loops built from the data, with the friction polished in, best one.
+        """Thin loops built from the data, with the friction polished in: the best two.
 
         The current chain has made what it could of the band with its own loop
         (a steep, wrong-way loop on a flat reading); the force is better found
         from a chain that leaves the band to the block: the family's data-built
-        loops a fiftieth of the measured width wide, the friction at each of
-        its starts, a short least-squares polish each, and the best polished
-        to the end.
+        loops a half, a twentieth and a two-hundredth of the measured width
+        wide (paper loops with their inner lines opened beyond the commanded
+        range, :func:`_open_ends`), the friction at each of its starts, a short
+        least-squares polish each, and the best two polished to the end.
         """
         from hyst_id.diagnosis.select import polish
         from hyst_id.identification.starts import data_starts as built
@@ -145,7 +146,8 @@ class Friction(Mechanism):
         sl = model.slices[self.id]
         chains = [_open_ends(c, data.v[:n]) if model.spec.family.id == 'tk' else c
                   for c in built(model.spec, data.t_s[:n], data.v[:n], data.y[:n],
-                                 splits=((0.5, 0.5), (0.05, 0.5)), per_split=1)]
+                                 splits=((0.5, 0.5), (0.05, 0.5), (0.005, 0.5)),
+                                 per_split=1)]
         chains = [c for c in chains if np.all((c >= model.bounds[:nc, 0])
                                               & (c <= model.bounds[:nc, 1]))]
         short = []
@@ -156,11 +158,8 @@ class Friction(Mechanism):
                 if model.feasible(p):
                     q, f, _ = polish(model, data, p, max_nfev=4 * (model.n_params + 1))
                     short.append((f, q))
-        if not short:
-            return []
-        f, q = min(short, key=lambda z: z[0])
-        q, _, _ = polish(model, data, q, max_nfev=600)
-        return [q]
+        short.sort(key=lambda z: z[0])
+        return [polish(model, data, q, max_nfev=600)[0] for _, q in short[:2]]
 
     def quantity_terms(self, theta, x, span) -> list[np.ndarray]:
         """Dahl's state along the travel."""
