@@ -79,6 +79,7 @@ sys.path.insert(0, str(ROOT / 'bench'))
 sys.path.insert(0, str(ROOT))
 
 from excitations import moves_and_holds  # noqa: E402, I100
+from friction_reference import euler_dahl  # noqa: E402, I100
 from generalisation import _draw_params, _excitation, EXCITATIONS  # noqa: E402, I100
 from reference_sim import first_order_sensor, second_order_sensor  # noqa: E402, I100
 from reference_sim import simulate as reference_simulate  # noqa: E402, I100
@@ -89,18 +90,6 @@ EFFECTS = ('dead_time', 'saturation', 'static_nonlinearity', 'actuator_dynamics'
 #: Recordings from this index on carry ``friction`` (joined the library after the first
 #: 150 were drawn; those stay as they were), alone or with the first effect drawn.
 FRICTION_FROM = 150
-
-
-def euler_dahl(x: np.ndarray, length: float, substeps: int = 50) -> np.ndarray:
-    """Dahl's friction state ``dz/dx = (1 - z sign(dx)) / length`` by small Euler steps."""
-    z = np.zeros(x.size)
-    zk = 0.0
-    for k in range(1, x.size):
-        dx = (x[k] - x[k - 1]) / substeps
-        for _ in range(substeps):
-            zk = min(1.0, max(-1.0, zk + dx / length * (1.0 - zk * np.sign(dx))))
-        z[k] = zk
-    return z
 
 
 def _logu(rng: np.random.Generator, lo: float, hi: float) -> float:

@@ -23,9 +23,9 @@ solution), as a drive moved through a seal reads it.
 
 from __future__ import annotations
 
+from friction_reference import euler_dahl
 import numpy as np
 import pytest
-
 from reference_sim import backlash, hysteresis
 
 from hyst_id.diagnosis import diagnose, DiagnoseSettings
@@ -42,18 +42,6 @@ FORCE_SHARE, PRESLIDING_SHARE = 0.08, 0.03
 GAIN, OFFSET = 25.0, -40.0
 
 
-def euler_dahl(x: np.ndarray, length: float, substeps: int = 100) -> np.ndarray:
-    """Dahl's state ``dz/dx = (1 - z sign(dx)) / length`` by small explicit steps."""
-    z = np.zeros(x.size)
-    zk = 0.0
-    for k in range(1, x.size):
-        dx = (x[k] - x[k - 1]) / substeps
-        for _ in range(substeps):
-            zk += dx / length * (1.0 - zk * np.sign(dx))
-        z[k] = zk
-    return z
-
-
 def friction_recording(seed: int) -> tuple[Recording, float, float]:
     """Two decaying sines through the chain, plus the friction force; 2,000 samples.
 
@@ -67,7 +55,7 @@ def friction_recording(seed: int) -> tuple[Recording, float, float]:
                  -0.15, 0.15)
     force = FORCE_SHARE * GAIN * np.ptp(x)
     length = PRESLIDING_SHARE * np.ptp(x)
-    y = GAIN * x + OFFSET + force * euler_dahl(x, length)
+    y = GAIN * x + OFFSET + force * euler_dahl(x, length, substeps=100)
     y = y + rng.normal(0.0, 0.003 * np.ptp(y), t.size)
     return Recording(t, v, y, 'position', 'mA', 'um', f'friction #{seed}'), force, length
 
@@ -143,7 +131,7 @@ def flat_friction_recording(seed: int) -> Recording:
     t = np.arange(2000) * 0.02
     x = (5.0 + 4.0 * np.sin(2 * np.pi * t / rng.uniform(6.0, 10.0)) * (1.0 - 0.3 * t / t[-1])
          + 0.5 * np.sin(2 * np.pi * t / rng.uniform(2.0, 3.0) + rng.uniform(0, 6)))
-    force = 20.0 + 0.3 * x + 2.0 * euler_dahl(x, 0.15)
+    force = 20.0 + 0.3 * x + 2.0 * euler_dahl(x, 0.15, substeps=100)
     return Recording(t, x, force + rng.normal(0.0, 0.02, t.size), 'position', 'mm', 'N',
                      f'flat friction #{seed}')
 
