@@ -357,7 +357,8 @@ def code_hash() -> str:
     h = hashlib.sha256()
     files = sorted([*(ROOT / 'hyst_id').rglob('*.py'),
                     *(ROOT / 'test' / 'reference_sim').rglob('*.py'),
-                    ROOT / 'test' / 'excitations.py', ROOT / 'bench' / 'generalisation.py'])
+                    ROOT / 'test' / 'excitations.py', ROOT / 'test' / 'friction_reference.py',
+                    ROOT / 'bench' / 'generalisation.py'])
     for f in files:
         h.update(str(f.relative_to(ROOT)).encode() + b'\0' + f.read_bytes())
     for fn in (draw, run):

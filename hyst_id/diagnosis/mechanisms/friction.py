@@ -172,16 +172,28 @@ class Friction(Mechanism):
         return v, (y - np.sum(own, axis=0)) if own else y
 
     @staticmethod
-    def _force_and_slope(coef, labels, span) -> tuple[float, float]:
+    def _force_and_change(coef, labels, span) -> tuple[float, float]:
+        """The friction force and the reading's change over the travel (both measured).
+
+        The change is the static map of the travel from its bottom to its top:
+        the linear term over the travel span, or, with a cubic curve of the
+        normalised travel ``z`` (:mod:`.static_nonlinearity`), the curve from
+        ``z = -1`` to ``1``; a creep's slow share adds to the linear term.
+        """
         labels = list(labels)
-        lo, hi = span
-        force = float(coef[labels.index('friction:0')])
-        slope = float(coef[labels.index('sensor')]) * (hi - lo)
-        return force, slope
+        c = dict(zip(labels, (float(x) for x in coef)))
+        force = c['friction:0']
+        gain = c['sensor'] + c.get('creep:0', 0.0)
+        if 'quantity:1' in c:            # basis z, z^2, z^3 of z in [-1, 1]
+            change = 2.0 * (gain + c.get('quantity:2', 0.0))
+        else:
+            lo, hi = span
+            change = gain * (hi - lo)
+        return force, change
 
     def describe(self, theta, coef, info, ctx) -> dict[str, Quantity]:
         """The force in measurement units, the presliding travel in command units."""
-        force, slope = self._force_and_slope(info['coef'], info['labels'], info['span'])
+        force, change = self._force_and_change(info['coef'], info['labels'], info['span'])
         lo, hi = info['span']
         presliding = float(theta[0]) * (hi - lo) / max(abs(info['pos_per_cmd']), 1e-300)
         return {'friction_force': Quantity(abs(force), ctx.meas_unit,
@@ -190,7 +202,10 @@ class Friction(Mechanism):
                 'higher_while_rising': Quantity(float(force > 0.0), 'bool',
                                                 '1 if the reading is higher while the command '
                                                 'rises (a clockwise loop against it)'),
-                'leads_motion': Quantity(float(force * slope >= 0.0), 'bool',
+                'reading_change': Quantity(change, ctx.meas_unit,
+                                           "the reading's own change over the travel, "
+                                           'bottom to top (the static map)'),
+                'leads_motion': Quantity(float(force * change > 0.0), 'bool',
                                          '1 if the band runs against the sense of the '
                                          "chain's own loop (a force with the motion)"),
                 'presliding': Quantity(presliding, ctx.cmd_unit,
@@ -198,14 +213,18 @@ class Friction(Mechanism):
                                        'reversal (1/e of the gap left)')}
 
     def implausible(self, theta, coef, span, noise_std, ctx=None, labels=None) -> str:
-        """A band below the noise, or one running the hysteresis's way on a sloped reading."""
+        """A band below the noise, or one running the hysteresis's way on a sloped reading.
+
+        Sloped: the reading changes over the travel by more than the band's
+        height (twice the force).
+        """
         if coef is None or labels is None or 'friction:0' not in labels:
             return ''
-        force, slope = self._force_and_slope(coef, labels, span)
+        force, change = self._force_and_change(coef, labels, span)
         if abs(force) < noise_std:
             return (f'its force ({abs(force):.3g} in the measurement) is below the '
                     f'measurement noise ({noise_std:.3g})')
-        if force * slope < 0.0 and abs(slope) > 2.0 * abs(force):
+        if force * change < 0.0 and abs(change) > 2.0 * abs(force):
             return ("its band lags the motion, as the hysteresis's own loop does (backlash, "
                     'curved branches), on a reading with a clear slope of its own')
         return ''
@@ -216,9 +235,15 @@ class Friction(Mechanism):
         pre = values['presliding']
         up, down = (('rises', 'falls') if values['higher_while_rising'].value
                     else ('falls', 'rises'))
-        sense = ("the loop this makes runs the other way round from the hysteresis's, "
-                 'so it is no lag' if values['leads_motion'].value else
-                 'the reading hardly changes with the travel, so the band is the loop')
+        change = abs(values['reading_change'].value)
+        if values['leads_motion'].value:
+            sense = ("the loop this makes runs the other way round from the hysteresis's, "
+                     'so it is no lag')
+        elif change <= 2.0 * f.value:
+            sense = 'the reading hardly changes with the travel, so the band is the loop'
+        else:
+            sense = ("but the band runs the hysteresis's own way round on a reading that "
+                     'changes over the travel: it may be backlash rather than friction')
         return (f'The measured {ctx.channel} carries a sliding-friction force of '
                 f'±{f.value:.3g} {f.unit}: higher while the command {up} than while it '
                 f'{down}, turning round within {pre.value:.3g} {pre.unit} of travel after '
