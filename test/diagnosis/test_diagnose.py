@@ -306,7 +306,7 @@ def test_bad_inputs_are_one_line_errors():
     with pytest.raises(NoExcitationError):
         diagnose(flat, settings=FAST)
     with pytest.raises(ConfigError, match='unknown mechanism'):
-        diagnose(rec, settings=DiagnoseSettings(mechanisms=('friction',)))
+        diagnose(rec, settings=DiagnoseSettings(mechanisms=('not_a_mechanism',)))
     with pytest.raises(ConfigError, match='train fraction'):
         diagnose(rec, settings=DiagnoseSettings(train_fraction=1.5))
     with pytest.raises(ConfigError, match='supply_decay cannot act on the position channel'):
@@ -336,7 +336,7 @@ def test_cli_errors_are_one_line(tmp_path, capsys):
     rec = synthetic(None)
     np.savetxt(csv, np.c_[rec.t_s, rec.command, rec.measurement], delimiter=',',
                header='t,command,measurement', comments='')
-    assert main(['diagnose', str(csv), '--mechanisms', 'friction']) == 2
+    assert main(['diagnose', str(csv), '--mechanisms', 'not_a_mechanism']) == 2
     assert 'unknown mechanism' in capsys.readouterr().err
     assert main(['diagnose', str(csv), '--mechanisms', 'supply_decay', '--quiet']) == 2
     err = capsys.readouterr().err.strip().splitlines()
