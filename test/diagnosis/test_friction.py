@@ -118,10 +118,11 @@ def test_a_force_band_with_the_motion_is_friction(seed):
 
     The presliding travel is reported in command units: the chain's right line and
     backlash move the travel 1.05 x the command there, so the truth is
-    ``length / 1.05``. Measured on seeds 0-5 (with these settings): named 6/6, force
-    0.997-1.004 x the truth, presliding 0.995-1.014 x, final held-out 0.91-1.08 x the
-    floor; seeds 0-2 under round-off probes 1 and 2 the same to three digits. The
-    bounds sit outside that. The compensator set is written (friction is not in-line).
+    ``length / 1.05``. Measured on seeds 0-5 (``python bench/friction_spread.py``):
+    named 6/6, force 0.997-1.004 x the truth, presliding 0.995-1.014 x, final held-out
+    0.91-1.08 x the floor; seeds 0-2 under round-off probes 1 and 2 the same to three
+    digits. The bounds sit outside that. The compensator set is written (friction is
+    not in-line).
     """
     rec, force, length = friction_recording(seed)
     d = diagnose(rec, settings=SETTINGS)
@@ -157,7 +158,8 @@ def flat_friction_recording(seed: int) -> Recording:
 def test_a_band_on_a_flat_force_is_friction():
     """Named with its force, in either sense (the reading has no slope to compare with).
 
-    Measured on seeds 0-5 and on seeds 0-1 under round-off probes 1 and 2: named
+    Measured on seeds 0-5 and on seeds 0-1 under round-off probes 1 and 2
+    (``python bench/friction_spread.py``): named
     10/10, force 1.973-2.003 N (true 2.0). Where the polish leaves the straight line
     under the band moves with round-off (final held-out 1.04-1.47 x the floor
     unperturbed, up to 4.0 x under the probes), so it is not asserted here.
