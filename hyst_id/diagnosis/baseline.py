@@ -27,6 +27,8 @@ trap them.
 
 from __future__ import annotations
 
+import hashlib
+
 import numpy as np
 
 from hyst_id.identification import identify, IdentifySettings
@@ -34,7 +36,12 @@ from hyst_id.identification.chains import ChainSpec
 from hyst_id.identification.starts import data_starts, SPLITS
 from hyst_id.io.recording import Recording
 
-__all__ = ['baseline_starts', 'structured_starts', 'whole_record_er']
+__all__ = ['baseline_starts', 'quick_memo', 'quick_starts', 'remember', 'structured_starts',
+           'whole_record_er']
+
+#: Most quick searches kept (:func:`quick_starts`); the oldest go first.
+QUICK_KEPT = 8
+_QUICK: dict[str, tuple[list[np.ndarray], list[np.ndarray]]] = {}
 
 
 def structured_starts(spec: ChainSpec, t_s: np.ndarray, v: np.ndarray, y: np.ndarray,
@@ -94,6 +101,47 @@ def baseline_starts(rec_train: Recording, spec: ChainSpec, settings, *, thorough
     x_fits = [np.array(r.x_raw, dtype=float) for r in sorted(runs, key=lambda r: r.fun)]
     return x_fits, structured_starts(spec, rec_train.t_s, rec_train.command,
                                      rec_train.measurement, x_fits[0][spec.sensor_slice])
+
+
+def _quick_key(rec_train: Recording, spec: ChainSpec, settings) -> str:
+    """What a quick search depends on: the samples, the domains and the search settings."""
+    h = hashlib.sha1()
+    for a in (rec_train.t_s, rec_train.command, rec_train.measurement, spec.bounds):
+        h.update(np.ascontiguousarray(a, dtype=float).tobytes())
+    h.update(repr((rec_train.channel, spec.family.id, spec.initial,
+                   sorted(_identify_base(settings).items()))).encode())
+    return h.hexdigest()
+
+
+def quick_starts(rec_train: Recording, spec: ChainSpec, settings
+                 ) -> tuple[list[np.ndarray], list[np.ndarray]]:
+    """:func:`baseline_starts` without the thorough search, remembered across rounds.
+
+    A family swap (:func:`hyst_id.diagnosis.trial.try_mechanism`) searches
+    the new family's chain on the training part in every round; the search
+    depends on nothing the rounds change, so its answer is kept (keyed on
+    the samples, domains and settings) and the next round reuses it. The
+    answer is the same either way: this only saves the repeated search.
+    """
+    key = _quick_key(rec_train, spec, settings)
+    if key not in _QUICK:
+        remember({key: baseline_starts(rec_train, spec, settings, thorough=False)})
+    x_fits, starts = _QUICK[key]
+    return [x.copy() for x in x_fits], [x.copy() for x in starts]
+
+
+def quick_memo() -> dict[str, tuple[list[np.ndarray], list[np.ndarray]]]:
+    """The quick searches this process holds (to carry from a worker to its parent)."""
+    return dict(_QUICK)
+
+
+def remember(memo: dict[str, tuple[list[np.ndarray], list[np.ndarray]]]) -> None:
+    """Keep ``memo``'s quick searches in this process (at most :data:`QUICK_KEPT`)."""
+    for key, value in memo.items():
+        _QUICK.pop(key, None)
+        _QUICK[key] = value
+    while len(_QUICK) > QUICK_KEPT:
+        del _QUICK[next(iter(_QUICK))]
 
 
 def whole_record_er(rec: Recording, spec: ChainSpec, settings) -> float:

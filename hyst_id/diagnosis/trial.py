@@ -33,7 +33,7 @@ from typing import Callable
 
 import numpy as np
 
-from hyst_id.diagnosis.baseline import baseline_starts
+from hyst_id.diagnosis.baseline import quick_memo, quick_starts, remember
 from hyst_id.diagnosis.locate import Localization
 from hyst_id.diagnosis.mechanisms.base import Context, Mechanism
 from hyst_id.diagnosis.model import ComposedModel, held
@@ -80,6 +80,7 @@ def try_all(mechs: list[Mechanism], current: FitResult, data: Data, ctx: Context
         for m in mechs:
             say(f'testing {m.id}')
             comps.append(try_mechanism(m, current, data, ctx, settings, loc, chain_starts))
+            comps[-1].memo = {}    # already held in this process
         return comps
     say(f'testing {", ".join(m.id for m in mechs)} in {workers} processes')
     order = sorted(range(len(mechs)), key=lambda i: (
@@ -92,6 +93,8 @@ def try_all(mechs: list[Mechanism], current: FitResult, data: Data, ctx: Context
     comps: list[Comparison | None] = [None] * len(mechs)
     for i, comp in zip(order, got):
         comps[i] = comp
+        remember(comp.memo)   # a swap's search, for the next round's workers (forked)
+        comp.memo = {}
     return comps
 
 
@@ -146,6 +149,8 @@ def try_mechanism(m: Mechanism, current: FitResult, data: Data, ctx: Context,
                 fit = got
     comp = compare(current, fit, data, m.id, settings.criteria)
     comp.screened = screened
+    if getattr(m, 'swap_family', ''):
+        comp.memo = quick_memo()
     comp.evidence, comp.where = m.evidence(loc)
     model = fit.model
     theta = model.theta(fit.p, m.id) if m.id in model.slices else np.zeros(0)
@@ -176,7 +181,8 @@ def _swap_family(m: Mechanism, current: FitResult, data: Data, ctx: Context,
 
     H's family changes the chain's parameters, so there is nothing to
     warm-start from: the new chain gets its own baseline fit (GAASS seeds and
-    data-built starts on the training part, each polished with the kept blocks).
+    data-built starts on the training part, each polished with the kept blocks;
+    the search is the same in every round, :func:`hyst_id.diagnosis.baseline.quick_starts`).
     """
     prev, fam, n = current.model, m.swap_family, data.n_train
     rec_train = Recording(data.t_s[:n], data.v[:n], data.y[:n], ctx.channel)
@@ -184,7 +190,7 @@ def _swap_family(m: Mechanism, current: FitResult, data: Data, ctx: Context,
     keep = [pm for pm in prev.mechanisms if pm.families is None or fam in pm.families]
     model = ComposedModel(ctx.channel, keep, ctx, spec.bounds, family=fam, swapped_by=m.id,
                           hold=prev.hold)
-    x_fits, starts = baseline_starts(rec_train, spec, settings, thorough=False)
+    x_fits, starts = quick_starts(rec_train, spec, settings)
     best = None
     for x0 in x_fits + starts:
         p0 = model.pack(x0, thetas)

@@ -53,7 +53,8 @@ from hyst_id.errors import ConfigError, InvalidParametersError
 from hyst_id.models.backlash import BACKLASH_NAMES, backlash_step, check_backlash
 from hyst_id.models.family import HysteresisFamily
 from hyst_id.models.registry import DEFAULT_FAMILY, get_family
-from hyst_id.models.sensors import first_order_coefficient, second_order_coefficients
+from hyst_id.models.sensors import first_order_coefficient, intervals_and_uniform
+from hyst_id.models.sensors import second_order_coefficients
 
 __all__ = ['CHAIN_NAMES', 'CHANNELS', 'HOLDS', 'INITIAL_STATES', 'PAPER_DOMAINS', 'PARAM_UNITS',
            'SENSOR_NAMES', 'ChainSpec', 'chain_names', 'chain_spec', 'er_percent', 'param_units']
@@ -228,13 +229,6 @@ def _sum_squares(y):
     return acc
 
 
-def _intervals(t_s: np.ndarray) -> tuple[np.ndarray, bool]:
-    d = np.diff(np.asarray(t_s, dtype=np.float64))
-    dt = np.ascontiguousarray(np.concatenate([d[:1], d]))
-    uniform = bool(np.all(np.abs(d - d[0]) <= 1e-9 * abs(d[0])))
-    return dt, uniform
-
-
 #: Largest number of H outputs (candidates x samples) held at once by the population cost.
 _BLOCK_VALUES = 262_144
 
@@ -359,7 +353,7 @@ class ChainSpec:
         """Vectorised cost J for a recording: ``(n, m)`` population -> ``(n,)``."""
         v = np.ascontiguousarray(command, dtype=np.float64)
         y = np.ascontiguousarray(measurement, dtype=np.float64)
-        dt, uniform = _intervals(t_s)
+        dt, uniform = intervals_and_uniform(t_s)
         kind = _KIND[self.channel]
         profile = self.profiled
         k, b = (1.0, 0.0) if profile else self.calibration
@@ -395,7 +389,7 @@ class ChainSpec:
         """
         p = self.check(params) if validate else np.ascontiguousarray(params, dtype=np.float64)
         v = np.ascontiguousarray(command, dtype=np.float64)
-        dt, uniform = _intervals(t_s)
+        dt, uniform = intervals_and_uniform(t_s)
         u = self.family.simulate(p[:self.n_h], self._h_command(v), validate=False)
         if self.falling:
             u = np.ascontiguousarray(u[1:])

@@ -37,8 +37,12 @@ import math
 from numba import njit
 import numpy as np
 
+from hyst_id.errors import RecordingError
+
 __all__ = [
     'first_order_coefficient',
+    'intervals_and_uniform',
+    'sample_intervals',
     'second_order_coefficients',
     'simulate_first_order',
     'simulate_second_order',
@@ -96,20 +100,57 @@ def _second_order(u, dt_s, zeta, omega_n):
     return x
 
 
-def _intervals(t_s: np.ndarray) -> np.ndarray:
-    t = np.asarray(t_s, dtype=np.float64)
-    d = np.diff(t)
-    return np.ascontiguousarray(np.concatenate([d[:1], d]))
+@njit(cache=True)
+def _interval_kernel(t):
+    n = t.shape[0]
+    if n < 2:
+        return np.empty(0)
+    dt = np.empty(n)
+    for j in range(1, n):
+        dt[j] = t[j] - t[j - 1]
+    dt[0] = dt[1]
+    return dt
+
+
+def sample_intervals(t_s: np.ndarray) -> np.ndarray:
+    """Interval before each sample, s (the first sample gets the first interval).
+
+    ``t[j] - t[j-1]`` exactly as :func:`numpy.diff` (one compiled pass: the
+    fits ask for it at every evaluation); empty for fewer than two samples.
+    """
+    return _interval_kernel(np.ascontiguousarray(t_s, dtype=np.float64))
+
+
+@njit(cache=True)
+def _all_equal(dt):
+    for j in range(dt.shape[0]):
+        if not abs(dt[j] - dt[0]) <= 1e-9 * abs(dt[0]):
+            return False
+    return True
+
+
+def intervals_and_uniform(t_s: np.ndarray) -> tuple[np.ndarray, bool]:
+    """:func:`sample_intervals` and whether they are all equal (within 1e-9 relative).
+
+    Raises
+    ------
+    RecordingError
+        Fewer than two samples.
+    """
+    dt = sample_intervals(t_s)
+    if dt.shape[0] == 0:
+        raise RecordingError('a chain needs at least two samples')
+    return dt, bool(_all_equal(dt))
 
 
 def simulate_first_order(u: np.ndarray, t_s: np.ndarray, tau_s: float) -> np.ndarray:
     """Response of ``1/(tau s + 1)`` to ``u`` sampled at ``t_s`` (seconds)."""
-    return _first_order(np.ascontiguousarray(u, dtype=np.float64), _intervals(t_s),
+    return _first_order(np.ascontiguousarray(u, dtype=np.float64), sample_intervals(t_s),
                         float(tau_s))
 
 
 def simulate_second_order(u: np.ndarray, t_s: np.ndarray, zeta: float,
                           omega_n_rad_s: float) -> np.ndarray:
     """Response of ``w^2/(s^2 + 2 zeta w s + w^2)`` to ``u`` sampled at ``t_s``."""
-    return _second_order(np.ascontiguousarray(u, dtype=np.float64), _intervals(t_s),
+    return _second_order(np.ascontiguousarray(u, dtype=np.float64), sample_intervals(t_s),
                          float(zeta), float(omega_n_rad_s))

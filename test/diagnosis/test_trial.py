@@ -111,3 +111,29 @@ def test_the_baseline_polishes_in_two_processes_equal_those_in_one(monkeypatch):
     for a, b in zip(one, two):
         np.testing.assert_array_equal(a[0], b[0])
         assert a[1:] == b[1:]
+
+
+def test_a_family_swaps_search_comes_back_from_its_worker_and_is_not_repeated(monkeypatch):
+    """The swap's quick search, made in a worker, serves the next round in the parent.
+
+    After a round in two processes the parent holds the search
+    (:func:`hyst_id.diagnosis.baseline.remember`); the same trial again, with
+    any new search made to fail, gives the same fit to the last bit.
+    """
+    from hyst_id.diagnosis import baseline
+
+    monkeypatch.setattr(baseline, '_QUICK', {})
+    data, ctx, current, loc = delayed_case()
+    mechs = get_mechanisms(('loop_shape', 'dead_time'), channel='position')
+    settings = DiagnoseSettings(fit_budget=200)
+    first = try_all(mechs, current, data, ctx, replace(settings, workers=2), loc, [])
+    assert len(baseline.quick_memo()) == 1
+    assert all(not c.memo for c in first)       # carried home, not kept in the report
+
+    def no_search(*args, **kwargs):
+        raise AssertionError('the quick search ran again')
+
+    monkeypatch.setattr(baseline, 'baseline_starts', no_search)
+    again = try_all(mechs[:1], current, data, ctx, replace(settings, workers=1), loc, [])
+    np.testing.assert_array_equal(again[0].fit.p, first[0].fit.p)
+    assert again[0].fit.sse_train == first[0].fit.sse_train
