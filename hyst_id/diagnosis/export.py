@@ -40,7 +40,6 @@ import numpy as np
 
 from hyst_id.compensation.augment import Augmentation, augmentation_from_findings
 from hyst_id.compensation.inverse import InverseModel
-from hyst_id.diagnosis.mechanisms.base import Mechanism
 from hyst_id.diagnosis.result import Diagnosis
 from hyst_id.errors import InvalidParametersError
 from hyst_id.identification.gauge import canonical_gauge, output_sign
@@ -70,8 +69,7 @@ def compensator_set(d: Diagnosis) -> tuple[InverseModel, Augmentation, list[tupl
     if model is None:
         raise InvalidParametersError('the diagnosis holds no fitted model')
     # a block with terms of its own only (friction) leaves the map of the travel alone
-    quantity = [m.id for m in model.mechanisms if m.stage == 'quantity'
-                and type(m).quantity is not Mechanism.quantity]
+    quantity = [m.id for m in model.mechanisms if m.stage == 'quantity' and m.maps_travel]
     if quantity and quantity != ['static_nonlinearity']:
         raise InvalidParametersError(f'{", ".join(quantity)} cannot be written as an output '
                                      'map of the compensator')

@@ -155,3 +155,18 @@ def test_travel_stops_become_command_limits():
         [{'mechanism': 'saturation', 'compensation': {'correction': corr}}], 120.0)
     assert (aug.min_command, aug.max_command) == (pytest.approx(4.9), pytest.approx(12.1))
     assert aug.schedule_horizon_s == 0.0 and applied[0][1].startswith('in-line')
+
+
+def test_blocks_that_map_the_travel_say_so():
+    """``maps_travel`` is set exactly on the blocks whose ``quantity`` replaces the map.
+
+    The compensator set refuses those it cannot invert by this flag, so a
+    block overriding :meth:`quantity` without it would slip through.
+    """
+    from hyst_id.diagnosis.mechanisms import Mechanism
+
+    for mid, m in MECHANISMS.items():
+        overrides = type(m).quantity is not Mechanism.quantity
+        assert m.maps_travel == overrides, mid
+    assert MECHANISMS['static_nonlinearity'].maps_travel
+    assert not MECHANISMS['friction'].maps_travel

@@ -157,6 +157,10 @@ class Mechanism:
     channels : tuple of str or None
         Channels whose physics the block can be (None: any): a supply running
         down changes pressure and flow, never the valve's position reading.
+    maps_travel : bool
+        Whether :meth:`quantity` replaces the reading's map of the travel by a
+        basis of its own (a static curve); blocks that only add terms
+        (:meth:`quantity_terms`, friction) leave the map alone.
     """
 
     id = ''  # noqa: A003 - the issue's word for a mechanism's name
@@ -170,6 +174,7 @@ class Mechanism:
     smooth = True
     families: tuple[str, ...] | None = None
     channels: tuple[str, ...] | None = None
+    maps_travel = False
 
     # -- fitting -----------------------------------------------------------
     def bounds(self, ctx: Context) -> np.ndarray:

@@ -45,6 +45,7 @@ from numba import njit
 import numpy as np
 
 from hyst_id.diagnosis.mechanisms.base import Context, Mechanism, Quantity
+from hyst_id.diagnosis.mechanisms.static_nonlinearity import curve_change
 
 __all__ = ['Friction', 'MECHANISM', 'dahl_state']
 
@@ -184,8 +185,8 @@ class Friction(Mechanism):
         c = dict(zip(labels, (float(x) for x in coef)))
         force = c['friction:0']
         gain = c['sensor'] + c.get('creep:0', 0.0)
-        if 'quantity:1' in c:            # basis z, z^2, z^3 of z in [-1, 1]
-            change = 2.0 * (gain + c.get('quantity:2', 0.0))
+        if 'quantity:1' in c:            # the static curve's basis z, z^2, z^3
+            change = curve_change(gain, c.get('quantity:2', 0.0))
         else:
             lo, hi = span
             change = gain * (hi - lo)

@@ -34,7 +34,17 @@ import numpy as np
 from hyst_id.compensation.augment import cubic_is_monotone, POLY_RANGE
 from hyst_id.diagnosis.mechanisms.base import Mechanism, Quantity
 
-__all__ = ['StaticNonlinearity', 'MECHANISM']
+__all__ = ['StaticNonlinearity', 'MECHANISM', 'curve_change']
+
+
+def curve_change(linear: float, cubic: float) -> float:
+    """The curve's change from the bottom (``z = -1``) to the top (``z = 1``) of the travel.
+
+    ``linear`` and ``cubic`` are the coefficients of ``z`` and ``z^3`` in the
+    basis ``z, z^2, z^3`` of :meth:`StaticNonlinearity.quantity` (``z^2``
+    is the same at both ends).
+    """
+    return 2.0 * (linear + cubic)
 
 
 class StaticNonlinearity(Mechanism):
@@ -48,6 +58,7 @@ class StaticNonlinearity(Mechanism):
     physics = ('the sensed quantity is not proportional to the actuator position (valve '
                'characteristic, pneumatic pressure/flow map, nonlinear transducer)')
     n_linear = 2
+    maps_travel = True
 
     def quantity(self, theta, x, span) -> list[np.ndarray]:
         """Basis ``z, z^2, z^3`` of the normalised position."""
@@ -66,7 +77,7 @@ class StaticNonlinearity(Mechanism):
         k = int(np.argmax(np.abs(dev)))
         slope = c1 + 2 * c2 * z + 3 * c3 * z * z
         top, bottom = c1 + 2 * c2 + 3 * c3, c1 - 2 * c2 + 3 * c3
-        span_meas = 2.0 * (c1 + c3)
+        span_meas = curve_change(c1, c3)
         out = {'a2': Quantity(c2 / c1 if c1 else np.nan, '1', 'quadratic term per linear term'),
                'a3': Quantity(c3 / c1 if c1 else np.nan, '1', 'cubic term per linear term'),
                'gain_ratio_top_bottom': Quantity(top / bottom if bottom else np.inf, '1',
