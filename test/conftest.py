@@ -64,6 +64,15 @@ def simulated():
     return get
 
 
+@pytest.fixture(autouse=True)
+def _no_kept_searches():
+    """Every test starts without the family swaps' kept searches of earlier tests."""
+    from hyst_id.diagnosis.baseline import forget_quick
+
+    forget_quick()
+    yield
+
+
 @pytest.fixture
 def ros_domain(monkeypatch):
     """A ROS domain id of its own for this test, localhost discovery only.

@@ -28,20 +28,23 @@ trap them.
 from __future__ import annotations
 
 import hashlib
+import os
+import threading
 
 import numpy as np
 
 from hyst_id.identification import identify, IdentifySettings
 from hyst_id.identification.chains import ChainSpec
 from hyst_id.identification.starts import data_starts, SPLITS
-from hyst_id.io.recording import Recording
+from hyst_id.io.recording import Recording, ROUNDOFF_PROBE_ENV
 
-__all__ = ['baseline_starts', 'quick_memo', 'quick_starts', 'remember', 'structured_starts',
-           'whole_record_er']
+__all__ = ['baseline_starts', 'forget_quick', 'quick_memo', 'quick_starts', 'remember',
+           'structured_starts', 'whole_record_er']
 
 #: Most quick searches kept (:func:`quick_starts`); the oldest go first.
 QUICK_KEPT = 8
-_QUICK: dict[str, tuple[list[np.ndarray], list[np.ndarray]]] = {}
+_QUICK: dict[str, tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...]]] = {}
+_QUICK_LOCK = threading.Lock()
 
 
 def structured_starts(spec: ChainSpec, t_s: np.ndarray, v: np.ndarray, y: np.ndarray,
@@ -104,12 +107,19 @@ def baseline_starts(rec_train: Recording, spec: ChainSpec, settings, *, thorough
 
 
 def _quick_key(rec_train: Recording, spec: ChainSpec, settings) -> str:
-    """What a quick search depends on: the samples, the domains and the search settings."""
+    """What a quick search depends on: the samples, the chain spec, the search settings.
+
+    Not the number of worker processes (the search is the same with any)
+    nor the stop check; the round-off probe is in (it perturbs the samples
+    again inside :func:`~hyst_id.identification.identify`).
+    """
     h = hashlib.sha1()
     for a in (rec_train.t_s, rec_train.command, rec_train.measurement, spec.bounds):
         h.update(np.ascontiguousarray(a, dtype=float).tobytes())
-    h.update(repr((rec_train.channel, spec.family.id, spec.initial,
-                   sorted(_identify_base(settings).items()))).encode())
+    search = {k: v for k, v in _identify_base(settings).items() if k != 'workers'}
+    h.update(repr((rec_train.channel, spec.channel, spec.family.id, spec.initial, spec.hold,
+                   spec.calibration, spec.domain_source, sorted(search.items()),
+                   os.environ.get(ROUNDOFF_PROBE_ENV, '').strip())).encode())
     return h.hexdigest()
 
 
@@ -120,28 +130,41 @@ def quick_starts(rec_train: Recording, spec: ChainSpec, settings
     A family swap (:func:`hyst_id.diagnosis.trial.try_mechanism`) searches
     the new family's chain on the training part in every round; the search
     depends on nothing the rounds change, so its answer is kept (keyed on
-    the samples, domains and settings) and the next round reuses it. The
-    answer is the same either way: this only saves the repeated search.
+    the samples, the spec and the settings) and the next round reuses it,
+    in this process or, handed over by :func:`hyst_id.diagnosis.trial.try_all`,
+    in its workers. The answer is the same either way: this only saves the
+    repeated search. Copies are returned; the kept arrays are never written.
     """
     key = _quick_key(rec_train, spec, settings)
-    if key not in _QUICK:
-        remember({key: baseline_starts(rec_train, spec, settings, thorough=False)})
-    x_fits, starts = _QUICK[key]
+    with _QUICK_LOCK:
+        got = _QUICK.get(key)
+    if got is None:
+        got = baseline_starts(rec_train, spec, settings, thorough=False)
+        remember({key: got})
+    x_fits, starts = got
     return [x.copy() for x in x_fits], [x.copy() for x in starts]
 
 
-def quick_memo() -> dict[str, tuple[list[np.ndarray], list[np.ndarray]]]:
-    """The quick searches this process holds (to carry from a worker to its parent)."""
-    return dict(_QUICK)
+def quick_memo() -> dict[str, tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...]]]:
+    """The quick searches this process holds (to hand between a round and its workers)."""
+    with _QUICK_LOCK:
+        return dict(_QUICK)
 
 
-def remember(memo: dict[str, tuple[list[np.ndarray], list[np.ndarray]]]) -> None:
+def remember(memo: dict) -> None:
     """Keep ``memo``'s quick searches in this process (at most :data:`QUICK_KEPT`)."""
-    for key, value in memo.items():
-        _QUICK.pop(key, None)
-        _QUICK[key] = value
-    while len(_QUICK) > QUICK_KEPT:
-        del _QUICK[next(iter(_QUICK))]
+    with _QUICK_LOCK:
+        for key, (x_fits, starts) in memo.items():
+            _QUICK.pop(key, None)
+            _QUICK[key] = (tuple(x_fits), tuple(starts))
+        while len(_QUICK) > QUICK_KEPT:
+            _QUICK.pop(next(iter(_QUICK)))
+
+
+def forget_quick() -> None:
+    """Drop every kept quick search (a long-running process may want a clean slate)."""
+    with _QUICK_LOCK:
+        _QUICK.clear()
 
 
 def whole_record_er(rec: Recording, spec: ChainSpec, settings) -> float:

@@ -87,13 +87,14 @@ def try_all(mechs: list[Mechanism], current: FitResult, data: Data, ctx: Context
         COSTLY_FIRST.index(mechs[i].id) if mechs[i].id in COSTLY_FIRST else len(COSTLY_FIRST)))
     # a worker does not start workers of its own; a stop check does not cross processes
     one = replace(settings, workers=1, should_stop=None)
-    got = map_in_processes(try_mechanism, [(mechs[i], current, data, ctx, one, loc, chain_starts)
-                                           for i in order], workers,
+    memo = quick_memo()     # the swaps' searches so far, for workers that did not fork them
+    got = map_in_processes(try_mechanism, [(mechs[i], current, data, ctx, one, loc, chain_starts,
+                                            memo) for i in order], workers,
                            on_result=lambda c: say(f'{c.mechanism} fitted'))
     comps: list[Comparison | None] = [None] * len(mechs)
     for i, comp in zip(order, got):
         comps[i] = comp
-        remember(comp.memo)   # a swap's search, for the next round's workers (forked)
+        remember(comp.memo)   # a swap's search, for the next round
         comp.memo = {}
     return comps
 
@@ -123,8 +124,14 @@ def _polish_one(model: ComposedModel, data: Data, x0: np.ndarray,
 
 def try_mechanism(m: Mechanism, current: FitResult, data: Data, ctx: Context,
                   settings: DiagnoseSettings, loc: Localization,
-                  chain_starts: list[np.ndarray]) -> Comparison:
-    """Fit ``m`` into ``current`` and judge it (the criteria, its evidence, its plausibility)."""
+                  chain_starts: list[np.ndarray], memo: dict | None = None) -> Comparison:
+    """Fit ``m`` into ``current`` and judge it (the criteria, its evidence, its plausibility).
+
+    ``memo``: family swaps' searches to reuse (:func:`hyst_id.diagnosis.baseline.quick_memo`
+    of the round's parent); a swap's own comes back in ``Comparison.memo``.
+    """
+    if memo:
+        remember(memo)
     prev = current.model
     thetas = {pm.id: prev.theta(current.p, pm.id) for pm in prev.mechanisms}
     screened = None

@@ -122,7 +122,6 @@ def test_a_family_swaps_search_comes_back_from_its_worker_and_is_not_repeated(mo
     """
     from hyst_id.diagnosis import baseline
 
-    monkeypatch.setattr(baseline, '_QUICK', {})
     data, ctx, current, loc = delayed_case()
     mechs = get_mechanisms(('loop_shape', 'dead_time'), channel='position')
     settings = DiagnoseSettings(fit_budget=200)
