@@ -377,6 +377,15 @@ def finished_rows(code: str, partial: Path = PARTIAL) -> list[dict]:
     return kept
 
 
+def rows_so_far(partial: Path = PARTIAL) -> list[dict]:
+    """The rows a run in parts on this code has finished (any ``--diagnose-workers``)."""
+    if not partial.exists():
+        return []
+    code = code_hash()
+    rows = [json.loads(line) for line in partial.read_text().splitlines() if line.strip()]
+    return [r for r in rows if r.get('code') == code or r.get('code', '').startswith(code + '-k')]
+
+
 def run_parts(indices: list[int], workers: int, stop_after_s: float, keep: bool, *,
               partial: Path = PARTIAL, one=None, code: str | None = None,
               inline: bool = False) -> list[dict]:
@@ -458,6 +467,9 @@ def main() -> int:
                          '(or the rows of a run in parts on this code, while there are any)')
     ap.add_argument('--from-json', action='store_true',
                     help='only reprint the tables from docs/diagnosis_blind.json')
+    ap.add_argument('--so-far', action='store_true',
+                    help='only print the tables of the rows a run in parts on this code has '
+                         'finished (docs/diagnosis_blind.partial.jsonl)')
     ap.add_argument('--csv', metavar='DIR',
                     help='only write the recordings (--indices, else --n) as DIR/blind_<i>.csv '
                          '(t,command,measurement: for hyst-id diagnose/identify with the '
@@ -470,7 +482,7 @@ def main() -> int:
     if args.csv:
         return write_csv(Path(args.csv), args.indices or list(range(args.n)))
     if args.compare:
-        now = finished_rows(code_hash())
+        now = rows_so_far()
         if now:
             print(f'comparing the {len(now)} rows of the run in parts on this code '
                   f'({PARTIAL.name})')
@@ -482,6 +494,14 @@ def main() -> int:
         return 0
     if args.from_json:
         print(summary(json.loads((ROOT / 'docs' / 'diagnosis_blind.json').read_text())))
+        return 0
+    if args.so_far:
+        rows = rows_so_far()
+        print(f'{len(rows)} recordings of the family finished on this code '
+              f'({PARTIAL.name}); the tables of those alone:')
+        ks = {r['code'].rpartition('-k')[2] for r in rows if '-k' in r['code']}
+        how = f'one at a time in {ks.pop()} processes' if len(ks) == 1 else 'one worker each'
+        print(summary(rows, how) if rows else 'none')
         return 0
     indices = args.indices or list(range(args.n))
     k = args.diagnose_workers
