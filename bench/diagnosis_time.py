@@ -50,47 +50,35 @@ from hyst_id.diagnosis.result import DiagnoseSettings  # noqa: E402
 from hyst_id.io.recording import Recording  # noqa: E402
 
 
+#: The identify searches of a diagnosis, by kind (counted as well as timed).
+SEARCHES = ('baseline search', 'swap quick search', 're-identification search')
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument('--indices', type=int, nargs='+', default=[1, 160])
     args = ap.parse_args()
     spent: dict = collections.defaultdict(float)
     counts: collections.Counter = collections.Counter()
-    trial_inner = trial.try_mechanism
 
-    def per_mechanism(m, *a, **k):
-        t0 = time.perf_counter()
-        try:
-            return trial_inner(m, *a, **k)
-        finally:
-            spent[f'trial {m.id}'] += time.perf_counter() - t0
+    def timed(inner, key_of):
+        """``inner`` with its wall time added under ``key_of(*args, **kwargs)``."""
+        def wrapper(*a, **k):
+            key, t0 = key_of(*a, **k), time.perf_counter()
+            try:
+                return inner(*a, **k)
+            finally:
+                spent[key] += time.perf_counter() - t0
+                counts[key] += key in SEARCHES
+        return wrapper
 
-    trial.try_mechanism = per_mechanism
-    search_inner = baseline.baseline_starts
-
-    def searches(rec, spec, settings, *, thorough=True, global_phase=None):
-        kind = ('baseline search' if thorough else 'swap quick search' if global_phase is None
-                else 're-identification search')
-        t0 = time.perf_counter()
-        try:
-            return search_inner(rec, spec, settings, thorough=thorough,
-                                global_phase=global_phase)
-        finally:
-            spent[kind] += time.perf_counter() - t0
-            counts[kind] += 1
-
+    trial.try_mechanism = timed(trial.try_mechanism, lambda m, *a, **k: f'trial {m.id}')
+    searches = timed(baseline.baseline_starts, lambda *a, thorough=True, global_phase=None: (
+        SEARCHES[0] if thorough else SEARCHES[1] if global_phase is None else SEARCHES[2]))
     for module in (baseline, driver, refit):        # each holds its own name for it
         module.baseline_starts = searches
-    starts_inner = Friction.data_starts
-
-    def friction_starts(self, *a, **k):
-        t0 = time.perf_counter()
-        try:
-            return starts_inner(self, *a, **k)
-        finally:
-            spent['friction data starts (in trial friction)'] += time.perf_counter() - t0
-
-    Friction.data_starts = friction_starts
+    Friction.data_starts = timed(Friction.data_starts,
+                                 lambda *a, **k: 'friction data starts (in trial friction)')
     for i in args.indices:
         case = draw(i)
         spent.clear()
@@ -105,10 +93,12 @@ def main() -> None:
         effects = '+'.join(case['effects']) or 'clean'
         print(f'#{i} ({effects}) -> {found}: {total:.1f} s in all, '
               f'{len(d.rounds)} rounds')
-        print('   ' + ', '.join(f'{k} x{n} {spent[k]:.1f} s' for k, n in sorted(counts.items())))
-        rows = sorted(((k, v) for k, v in spent.items() if k not in counts),
+        print('   ' + ', '.join(f'{k} x{n} {spent[k]:.1f} s' for k, n in sorted(counts.items())
+                                if n))
+        rows = sorted(((k, v) for k, v in spent.items() if k not in SEARCHES),
                       key=lambda kv: -kv[1])
-        print('   ' + ', '.join(f'{k} {v:.1f} s' for k, v in rows))
+        if rows:
+            print('   ' + ', '.join(f'{k} {v:.1f} s' for k, v in rows))
 
 
 if __name__ == '__main__':

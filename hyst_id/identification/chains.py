@@ -53,8 +53,8 @@ from hyst_id.errors import ConfigError, InvalidParametersError
 from hyst_id.models.backlash import BACKLASH_NAMES, backlash_step, check_backlash
 from hyst_id.models.family import HysteresisFamily
 from hyst_id.models.registry import DEFAULT_FAMILY, get_family
-from hyst_id.models.sensors import first_order_coefficient, intervals_and_uniform
-from hyst_id.models.sensors import second_order_coefficients
+from hyst_id.models.sensors import (first_order_coefficient, intervals_and_uniform,
+                                    second_order_coefficients)
 
 __all__ = ['CHAIN_NAMES', 'CHANNELS', 'HOLDS', 'INITIAL_STATES', 'PAPER_DOMAINS', 'PARAM_UNITS',
            'SENSOR_NAMES', 'ChainSpec', 'chain_names', 'chain_spec', 'er_percent', 'param_units']
