@@ -65,6 +65,10 @@ def add_settings_arguments(parser: argparse.ArgumentParser, identify: bool = Tru
     g.add_argument('--hops', type=int, default=100, metavar='N',
                    help='when the best seed ends between 1.1 and 4 x the noise floor, the '
                    'most jumps of basin hopping from it, each polished (default 100; 0 = none)')
+    g.add_argument('--more-starts', action='store_true',
+                   help='when the chains built from the data stop above the noise floor, '
+                   'build five more ways of sharing the loop between H and the backlash '
+                   '(slower; finds narrow basins, see docs/model.md)')
     g.add_argument('--domains', default='auto', metavar='auto|paper|YAML',
                    help="search domains: derived from the data (auto), the paper's "
                    'preset (paper), or a YAML mapping name: [low, high] that overrides '
@@ -116,7 +120,7 @@ def make_settings(args: argparse.Namespace) -> IdentifySettings:
         generations=args.generations, c=args.c, xi=args.xi, workers=args.workers,
         refine=not args.gaass_only, restarts=args.restarts, er_bound_percent=args.er_bound,
         global_evals=args.global_evals, global_runs=args.global_runs, hops=args.hops,
-        search_samples=args.search_samples)
+        search_samples=args.search_samples, more_starts=args.more_starts)
 
 
 def make_spec(args: argparse.Namespace, rec: Recording, family: str | None = None) -> ChainSpec:

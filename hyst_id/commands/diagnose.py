@@ -86,7 +86,8 @@ def _settings(args: argparse.Namespace):
         train_fraction=args.train_fraction,
         seeds=tuple(range(args.seed_offset, args.seed_offset + args.seeds)),
         generations=args.generations, pop_size=args.pop_size, workers=args.workers,
-        mechanisms=mechs, max_mechanisms=args.max_mechanisms, hops=args.hops)
+        mechanisms=mechs, max_mechanisms=args.max_mechanisms, hops=args.hops,
+        more_starts=args.more_starts)
 
 
 def _write_params(diag, path: str) -> None:

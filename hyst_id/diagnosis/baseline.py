@@ -96,7 +96,8 @@ def baseline_starts(rec_train: Recording, spec: ChainSpec, settings, *, thorough
         # one global run in the given conventions, two (best and runner-up) in 'auto'
         ident = identify(rec_train, spec=spec, settings=IdentifySettings(
             **base, conventions=conventions, global_evals=global_evals,
-            global_runs=1 if conventions == 'given' else 2),
+            global_runs=1 if conventions == 'given' else 2,
+            more_starts=settings.more_starts and use_global),
             should_stop=settings.should_stop)
         own = [r for r in ident.runs if r.initial == spec.initial]
         if own:
@@ -179,4 +180,5 @@ def whole_record_er(rec: Recording, spec: ChainSpec, settings) -> float:
     """
     base = _identify_base(settings)
     return float(identify(rec, spec=spec, settings=IdentifySettings(
-        **base, global_runs=4), should_stop=settings.should_stop).er_percent)
+        **base, global_runs=4, more_starts=settings.more_starts),
+        should_stop=settings.should_stop).er_percent)

@@ -63,6 +63,15 @@ class DiagnoseSettings:
         for nothing, on the blind family's clean #27 they are what makes its
         baseline predict the held-out part (20 do not reach it;
         ``bench/diagnosis_hops.py``). The tests' short settings take 20.
+    more_starts : bool
+        The baseline's and the whole record's identifications (those with a
+        global phase) build more chains from the data when the usual ones
+        stop above the floor (identify's ``more_starts``). Off by default:
+        on 75 recordings of the blind family it took the physics claims off
+        the two clean recordings that had them (#59, #63), moved two verdicts
+        on recordings with effects the wrong way (#9 saturation -> friction,
+        #23 static_nonlinearity -> creep) and made the median diagnosis 1.7 x
+        slower (docs/diagnosis.md).
     should_stop : callable, optional
         Passed to the baseline's identifications (``identify(should_stop=...)``:
         looked at before each jump of hopping and each generation of an
@@ -81,6 +90,7 @@ class DiagnoseSettings:
     criteria: Criteria = field(default_factory=Criteria)
     fit_budget: int = 600
     hops: int = 100
+    more_starts: bool = False
     should_stop: Callable[[], bool] | None = field(default=None, compare=False, repr=False)
 
 

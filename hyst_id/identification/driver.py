@@ -32,25 +32,20 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from hyst_id.errors import IdentificationError, InvalidParametersError
-from hyst_id.identification.chains import (
-    chain_spec,
-    ChainSpec,
-    er_percent,
-    HOLDS,
-    INITIAL_STATES,
-)
+from hyst_id.identification.chains import chain_spec, ChainSpec, er_percent
 from hyst_id.identification.domains import domains_from_data
 from hyst_id.identification.gauge import canonical_gauge, output_sign
 from hyst_id.identification.global_phase import global_phase, global_phases
 from hyst_id.identification.hop import HOP_RUN_ID, hop_with_cost
+from hyst_id.identification.incumbent import best_polished, choose_conventions
+from hyst_id.identification.incumbent import CONVENTION_GAIN, data_incumbent
+from hyst_id.identification.incumbent import rank_conventions, search_subset
 from hyst_id.identification.quality import assess
 from hyst_id.identification.refine import refine
 from hyst_id.identification.result import Identification, IdentifySettings, SeedRun
-from hyst_id.identification.starts import data_starts
 from hyst_id.identification.workers import map_in_processes, WorkersStopped
 from hyst_id.io.recording import Recording, roundoff_probe, validate_recording
 from hyst_id.signals.noise import noise_floor_percent
-from hyst_id.signals.reversals import reversal_indices
 from hyst_id.solvers.gaass import GaassSolver
 
 __all__ = ['choose_conventions', 'data_incumbent', 'global_phase', 'identify', 'rank_conventions',
@@ -129,7 +124,7 @@ def _run_seed(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray, measurement
             candidates = []
             starts = _distinct_best(res.population, res.population_fun, settings.refine_top)
             if sub is not None:         # polish all on the subset, the best on every sample
-                x_sub, nfev_sub = _best_polished(here, starts, search, settings.refine_max_nfev)
+                x_sub, nfev_sub = best_polished(here, starts, search, settings.refine_max_nfev)
                 starts, nfev = [x_sub], nfev + nfev_sub
             for x0 in starts:
                 x_ref, fun_ref, nfev_ref = refine(here, x0, t_s, command, measurement,
@@ -139,7 +134,7 @@ def _run_seed(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray, measurement
         previous = best_fun
         for x, fun in candidates:
             # another convention must gain clearly, as in rank_conventions
-            if fun < (best_fun if here is best_spec else _CONVENTION_GAIN * best_fun):
+            if fun < (best_fun if here is best_spec else CONVENTION_GAIN * best_fun):
                 best_x, best_fun, best_spec = x, fun, here
         if best_fun <= good_enough or (target is not None and best_fun <= target):
             break
@@ -159,147 +154,6 @@ def _run_seed(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray, measurement
                    er_percent=float(er_percent(best_fun, measurement)), er_gaass_percent=er_ga,
                    nfev=nfev, nit=nit, best_history=history, message=message,
                    initial=best_spec.initial, hold=best_spec.hold)
-
-
-def data_incumbent(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray,
-                   measurement: np.ndarray, settings: IdentifySettings
-                   ) -> tuple[np.ndarray, float, int] | None:
-    """The best chain built from the data, polished: ``(x, cost, nfev)`` or None.
-
-    Every start of :func:`hyst_id.identification.starts.data_starts` (loop
-    width at the median crossing, flat inner lines, unit side slopes,
-    backlash shares, sensor time constants) gets a short polish, the best
-    two a full one. These starts lie outside the "linear H + backlash"
-    basin that a global search can fall into.
-    """
-    with threadpool_limits(limits=1):
-        try:
-            starts = data_starts(spec, t_s, command, measurement)
-        except (InvalidParametersError, ValueError):
-            return None
-        if not starts:
-            return None
-        short, nfev = [], 0
-        sub = search_subset(command, settings.search_samples)
-        search = (t_s, command, measurement) if sub is None else \
-            (t_s[sub], command[sub], measurement[sub])
-        # the short polishes only rank the starts: a quarter of the subset on a long record
-        few = search_subset(command, settings.search_samples // 4) if sub is not None else None
-        ranking = search if few is None else (t_s[few], command[few], measurement[few])
-        for x0 in starts:
-            x, fun, k = refine(spec, x0, *ranking,
-                               max_nfev=_SHORT_POLISH * (spec.n_params + 1), restarts=0)
-            nfev += k
-            short.append((fun, x))
-        short.sort(key=lambda z: z[0])
-        finalists = [x0 for _, x0 in short[:2]]
-        if sub is not None:             # polish both on the subset, the better on all samples
-            x_sub, nfev_sub = _best_polished(spec, finalists, search, settings.refine_max_nfev)
-            finalists, nfev = [x_sub], nfev + nfev_sub
-        best_x, best_fun = None, np.inf
-        for x0 in finalists:
-            x, fun, k = refine(spec, x0, t_s, command, measurement,
-                               max_nfev=settings.refine_max_nfev)
-            nfev += k
-            if fun < best_fun:
-                best_x, best_fun = x, fun
-    return (best_x, float(best_fun), nfev) if best_x is not None else None
-
-
-def _best_polished(spec: ChainSpec, starts: list[np.ndarray], data: tuple, max_nfev: int
-                   ) -> tuple[np.ndarray, int]:
-    """The best of ``starts`` each refined on ``data`` (a search subset), and the evaluations."""
-    polished, nfev = [], 0
-    for x0 in starts:
-        x, fun, k = refine(spec, x0, *data, max_nfev=max_nfev)
-        nfev += k
-        polished.append((fun, x))
-    return min(polished, key=lambda z: z[0])[1], nfev
-
-
-def search_subset(command: np.ndarray, max_samples: int) -> np.ndarray | None:
-    """Indices of a search subset of a long record, or None to use every sample.
-
-    Every ``k``-th sample (``k`` from ``max_samples``) plus the first and last
-    and every command reversal (its extreme sample,
-    :func:`hyst_id.signals.reversals.reversal_indices` with no tolerance), in
-    order. A rate-independent chain (H, B) gives the same output at the kept
-    samples as on the whole record, since between two kept samples the
-    command moves one way; sensor dynamics then see the command held over
-    ``k`` samples, a small change at rates well above the sensor's bandwidth.
-    None when ``max_samples`` is 0, the record is not longer, or the
-    reversals alone would keep more than half of it (a noisy command).
-    """
-    v = np.asarray(command, dtype=float)
-    n = v.size
-    if max_samples <= 0 or n <= max_samples:
-        return None
-    turns = reversal_indices(v, tolerance=0.0)[0]
-    if turns.size > n // 2:
-        return None
-    step = max(2, int(np.ceil(n / max_samples)))
-    keep = np.concatenate([np.arange(0, n, step), turns, [n - 1]])
-    return np.unique(keep)
-
-
-def rank_conventions(spec: ChainSpec, rec: Recording, incumbent: tuple[np.ndarray, float, int],
-                     settings: IdentifySettings
-                     ) -> list[tuple[ChainSpec, tuple[np.ndarray, float, int]]]:
-    """Every initial state and sensor hold convention, best fitting first.
-
-    A recording made by another simulator or a real rig may start on the
-    falling boundary of the loop, and may sample its sensor before or after
-    the command of the same instant acts (:attr:`ChainSpec.initial`,
-    :attr:`ChainSpec.hold`). The data-built starts depend on the initial
-    state, so :func:`data_incumbent` runs again under each other initial
-    state (``incumbent`` is the spec's own); every incumbent is then polished
-    under the other sensor hold (it only matters with sensor dynamics).
-    Another convention ranks above the spec's only when it lowers the cost by
-    more than 0.1 %, so that a recording where they make no difference keeps
-    the defaults. Each entry is ``(spec, (x, cost, nfev))``; the first
-    entry's ``nfev`` counts every evaluation made here.
-    """
-    holds = HOLDS if spec.channel != 'position' else (spec.hold,)
-    args = (rec.t_s, rec.command, rec.measurement)
-    ranked = [(spec, incumbent)]
-    nfev = incumbent[2]
-    with threadpool_limits(limits=1):
-        for initial in INITIAL_STATES:
-            if initial != spec.initial:
-                trial = replace(spec, initial=initial)
-                found = data_incumbent(trial, *args, settings)
-                if found is None:
-                    continue
-                nfev += found[2]
-                ranked.append((trial, (found[0], found[1], 0)))
-        for base, (x0, _, _) in list(ranked):
-            for hold in holds:
-                if hold == base.hold:
-                    continue
-                trial = replace(base, hold=hold)
-                x, fun, k = refine(trial, x0, *args, max_nfev=settings.refine_max_nfev)
-                nfev += k
-                ranked.append((trial, (x, float(fun), 0)))
-    clearly = [e for e in ranked[1:] if e[1][1] < _CONVENTION_GAIN * incumbent[1]]
-    winner = min(clearly, key=lambda e: e[1][1]) if clearly else ranked[0]
-    ranked = [winner] + sorted((e for e in ranked if e is not winner), key=lambda e: e[1][1])
-    first_spec, (x, fun, _) = ranked[0]
-    ranked[0] = (first_spec, (x, fun, nfev))
-    return ranked
-
-
-def choose_conventions(spec: ChainSpec, rec: Recording, incumbent: tuple[np.ndarray, float, int],
-                       settings: IdentifySettings
-                       ) -> tuple[ChainSpec, tuple[np.ndarray, float, int]]:
-    """The initial state and sensor hold convention that fit best (:func:`rank_conventions`)."""
-    return rank_conventions(spec, rec, incumbent, settings)[0]
-
-
-#: Another initial state or hold is taken only below this share of the current cost.
-_CONVENTION_GAIN = 0.999
-
-#: Evaluations per parameter (plus one) of the short polish of each data-built start.
-_SHORT_POLISH = 8
 
 
 def _report(on_generation: Callable[[int, int, int, float], Any] | None, seed: int,
@@ -386,10 +240,12 @@ def identify(recording: Recording, *, spec: ChainSpec | None = None,
         raise IdentificationError('no seeds given')
     floor = noise_floor_percent(rec.measurement)
     args = (spec, rec.t_s, rec.command, rec.measurement, settings)
-    incumbent = data_incumbent(*args) if settings.refine and settings.data_starts else None
+    more_above = floor if settings.more_starts else None     # more data-built starts above it
+    incumbent = data_incumbent(*args, more_above) if settings.refine and settings.data_starts \
+        else None
     others: list[ChainSpec] = []
     if incumbent is not None and settings.conventions == 'auto':
-        ranked = rank_conventions(spec, rec, incumbent, settings)
+        ranked = rank_conventions(spec, rec, incumbent, settings, more_above)
         spec, incumbent = ranked[0]
         others = [e[0] for e in ranked[1:]] + [spec] if len(ranked) > 1 else []
         args = (spec, rec.t_s, rec.command, rec.measurement, settings)

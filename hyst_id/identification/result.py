@@ -65,12 +65,12 @@ class IdentifySettings:
     data_starts : bool
         With refinement on, polish the chains built from the data once and
         give every seed the best of them as the result to beat
-        (:func:`hyst_id.identification.driver.data_incumbent`). Off, or with
+        (:func:`hyst_id.identification.incumbent.data_incumbent`). Off, or with
         ``refine=False`` (the paper's procedure), seeds start from GAASS alone.
     conventions : {'auto', 'given'}
         ``auto``: with data starts on, choose the chain's initial state and
         sensor hold convention from the data
-        (:func:`hyst_id.identification.driver.rank_conventions`; a seed's
+        (:func:`hyst_id.identification.incumbent.rank_conventions`; a seed's
         odd restarts try the runner-up); ``given``: keep the spec's.
     global_evals : int
         With refinement on, when the seeds end above ``global_factor`` times
@@ -105,10 +105,22 @@ class IdentifySettings:
         polishes of each run's best chromosomes and of the data-built starts
         see about this many samples: every k-th sample plus every command
         reversal (the loop's memory),
-        :func:`hyst_id.identification.driver.search_subset`; the best of each
+        :func:`hyst_id.identification.incumbent.search_subset`; the best of each
         group is then polished on all samples, and every cost compared
         between seeds and every figure reported uses all samples. 0: always
         all.
+    more_starts : bool
+        With data starts on, when the incumbent of the four splits of the
+        loop width (:data:`hyst_id.identification.starts.SPLITS`) stays above
+        the noise floor: the five of
+        :data:`~hyst_id.identification.starts.MORE_SPLITS` too, and under
+        ``conventions='auto'`` the data-built starts ranked again under the
+        other sensor hold (:func:`hyst_id.identification.incumbent.data_incumbent`,
+        :func:`~hyst_id.identification.incumbent.rank_conventions`). Off by
+        default: in a diagnosis's baseline it took the claims off the two
+        clean blind recordings that had them (#59, #63) but moved two
+        verdicts of recordings with effects the wrong way and made a
+        diagnosis 1.7 x slower (median, 75 recordings; docs/diagnosis.md).
     """
 
     pop_size: int = 10
@@ -132,6 +144,7 @@ class IdentifySettings:
     long_runs_within: float = 4.0
     hops: int = 100
     search_samples: int = 20000
+    more_starts: bool = False
 
 
 @dataclass

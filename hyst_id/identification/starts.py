@@ -30,10 +30,18 @@ from hyst_id.identification.chains import ChainSpec
 from hyst_id.identification.loop import loop_width
 from hyst_id.models.family import LoopBox
 
-__all__ = ['SPLITS', 'box_of', 'data_starts', 'sensor_guesses']
+__all__ = ['MORE_SPLITS', 'SPLITS', 'box_of', 'data_starts', 'sensor_guesses']
 
 #: (loop width / measured width, share of it given to B) of the data-built starts.
 SPLITS = ((1.0, 0.1), (1.0, 0.5), (0.7, 0.1), (1.4, 0.1))
+
+#: The rest of the grid of widths 0.7, 1.0, 1.4 x the measured one with 10, 30 and 50 % of
+#: it in B, tried by identify's incumbent when the starts of :data:`SPLITS` stop above
+#: the floor (:func:`hyst_id.identification.driver.data_incumbent`). The true chain's basin
+#: can be narrow when H and B share the width about evenly: on clean recordings of the
+#: independent reference (bench/blind_family.py #59, #63, #122, #32) the best incumbent
+#: came from one of these (``python bench/start_splits.py``).
+MORE_SPLITS = ((0.7, 0.3), (0.7, 0.5), (1.0, 0.3), (1.4, 0.3), (1.4, 0.5))
 
 
 def box_of(spec: ChainSpec, t_s: np.ndarray, v: np.ndarray, y: np.ndarray) -> LoopBox:

@@ -1,0 +1,78 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""The data-built incumbent: four splits, five more while above a floor it is given.
+
+On blind recording #63 of ``bench/blind_family.py`` (independent reference
+simulator, clean pressure, random steps) the four splits of
+:data:`~hyst_id.identification.starts.SPLITS` polish into other basins than
+the true chain's (2.8-2.9 x the floor): the five of
+:data:`~hyst_id.identification.starts.MORE_SPLITS` are asked for there. Which
+basin a polish ends in turns on round-off there (``bench/start_splits.py``,
+docs/model.md), so this test checks the rule, not a figure;
+``test/diagnosis/test_clean_blind.py`` checks what it buys on #59.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+import sys
+
+import numpy as np
+
+from hyst_id.identification import incumbent
+from hyst_id.identification.chains import chain_spec
+from hyst_id.identification.result import IdentifySettings
+from hyst_id.identification.starts import MORE_SPLITS, SPLITS
+from hyst_id.io.recording import Recording, roundoff_probe, validate_recording
+from hyst_id.signals.split import split_index
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / 'bench'))
+import blind_family  # noqa: E402, I100
+
+__all__: list[str] = []
+
+
+def _training_part(index: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The first 70 % in a diagnosis's normalised command scale (7-11), probed.
+
+    Under ``HYST_ID_ROUNDOFF_PROBE`` perturbed at round-off level as identify
+    and diagnose perturb what they are given (:func:`roundoff_probe`).
+    """
+    case = blind_family.draw(index)
+    t, u, y = case['t'], case['command'], case['measurement']
+    n = split_index(t, 0.7)
+    lo, hi = float(u[:n].min()), float(u[:n].max())
+    half = 0.5 * (hi - lo)
+    v = (u[:n] - (0.5 * (lo + hi) - 4.5 * half)) / (half / 2.0)
+    rec = roundoff_probe(validate_recording(Recording(t[:n], v, y[:n], case['channel'])))
+    return rec.t_s, rec.command, rec.measurement
+
+
+def test_more_splits_only_with_a_floor_and_above_it(monkeypatch):
+    """No floor or a floor the four reach: the four alone; otherwise the five too."""
+    asked = []
+    real = incumbent.data_starts
+
+    def spy(*args, splits, **kwargs):
+        asked.append(splits)
+        return real(*args, splits=splits, **kwargs)
+
+    monkeypatch.setattr(incumbent, 'data_starts', spy)
+    t, v, y = _training_part(63)
+    spec = chain_spec('pressure')
+    for floor, want in ((None, [SPLITS]), (1e3, [SPLITS]), (1e-6, [SPLITS, MORE_SPLITS])):
+        asked.clear()
+        got = incumbent.data_incumbent(spec, t, v, y, IdentifySettings(), floor)
+        assert asked == want and got is not None
