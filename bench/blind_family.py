@@ -169,8 +169,12 @@ def draw(index: int) -> dict:
             'noise_percent_of_span': 100.0 * sigma / span}
 
 
-def run(index: int, workers: int = 1) -> dict:
-    """Draw and diagnose one recording (``workers`` processes); what the tables need."""
+def run(index: int, workers: int = 1, more_starts: bool = False) -> dict:
+    """Draw and diagnose one recording (``workers`` processes); what the tables need.
+
+    ``more_starts``: the baseline's identify builds more chains from the data
+    (``DiagnoseSettings.more_starts``; off, as by default, in the documented run).
+    """
     from hyst_id.diagnosis import diagnose, DiagnoseSettings
     from hyst_id.diagnosis.blocked_cv import confirmed
     from hyst_id.io.recording import Recording
@@ -178,7 +182,7 @@ def run(index: int, workers: int = 1) -> dict:
     rec = Recording(case['t'], case['command'], case['measurement'], case['channel'],
                     source=f'blind #{index}')
     t0 = time.time()
-    d = diagnose(rec, settings=DiagnoseSettings(workers=workers))
+    d = diagnose(rec, settings=DiagnoseSettings(workers=workers, more_starts=more_starts))
     j = d.extra['judged_holdout']
     out = {k: case[k] for k in ('index', 'channel', 'excitation', 'dt_s', 'effects',
                                 'magnitudes', 'noise_percent_of_span')}
@@ -475,6 +479,9 @@ def main() -> int:
                          '(t,command,measurement: for hyst-id diagnose/identify with the '
                          "recording's --channel) and what was put in as "
                          'DIR/blind_<i>.truth.json')
+    ap.add_argument('--more-starts', action='store_true',
+                    help="with --indices: the baseline's identify builds more chains from the "
+                         'data (DiagnoseSettings.more_starts; docs/diagnosis.md, section 1)')
     ap.add_argument('--stop-after-min', type=float, default=float('inf'), metavar='M',
                     help='start no new recording after M minutes (a full run resumes from '
                          'docs/diagnosis_blind.partial.jsonl next time)')
@@ -503,15 +510,19 @@ def main() -> int:
         how = f'one at a time in {ks.pop()} processes' if len(ks) == 1 else 'one worker each'
         print(summary(rows, how) if rows else 'none')
         return 0
+    if args.more_starts and not args.indices:
+        print('--more-starts only with --indices (the documented run uses the defaults)')
+        return 2
     indices = args.indices or list(range(args.n))
     k = args.diagnose_workers
+    one = functools.partial(run, more_starts=args.more_starts)
     how = 'one worker each' if k <= 1 else f'one at a time in {k} processes'
     full = not (args.no_write or args.indices)
     if k <= 1:
-        rows = run_parts(indices, args.workers, 60.0 * args.stop_after_min, keep=full)
+        rows = run_parts(indices, args.workers, 60.0 * args.stop_after_min, keep=full, one=one)
     else:           # the rows of such a run are marked apart: their seconds mean another thing
         rows = run_parts(indices, 1, 60.0 * args.stop_after_min, keep=full,
-                         one=functools.partial(run, workers=k), code=f'{code_hash()}-k{k}',
+                         one=functools.partial(one, workers=k), code=f'{code_hash()}-k{k}',
                          inline=True)
     if len(rows) < len(indices):
         print(f'stopped after {len(rows)}/{len(indices)} recordings; run again to go on')
