@@ -12,7 +12,7 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
-"""Identify's data-built incumbent: the four splits alone, then five more below the floor.
+"""Identify's data-built incumbent: the four splits alone, then five more above the floor.
 
 ``python bench/start_splits.py [--indices 59 122 ...]``
 
@@ -61,7 +61,7 @@ DEFAULT_INDICES = (59, 63, 122, 32, 111, 87, 65, 19, 2)
 
 
 def _incumbent(spec, t, v, y, floor: float | None, splits: tuple = SPLITS) -> float:
-    """%e_r of data_incumbent's chain (``splits`` as its first set), and the seconds."""
+    """%e_r of data_incumbent's chain (``splits`` as its first set)."""
     real = incumbent.SPLITS
     incumbent.SPLITS = splits
     try:
@@ -70,7 +70,7 @@ def _incumbent(spec, t, v, y, floor: float | None, splits: tuple = SPLITS) -> fl
         incumbent.SPLITS = real
     if got is None:
         return float('nan')
-    return float(er_percent(spec.cost_function(t, v, y)(got[0][None])[0], y))
+    return float(er_percent(got[1], y))
 
 
 def main(argv: list[str] | None = None) -> int:

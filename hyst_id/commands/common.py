@@ -52,7 +52,7 @@ def add_settings_arguments(parser: argparse.ArgumentParser, identify: bool = Tru
     """GAASS and refinement settings (paper's defaults).
 
     With ``identify=False`` only what ``diagnose`` passes on to its fits
-    (seeds, population, generations, workers, hops, domains): the
+    (seeds, population, generations, workers, hops, more starts, domains): the
     identification-only flags are not registered, so giving one is a usage
     error rather than a flag silently ignored.
     """

@@ -112,7 +112,9 @@ def _quick_key(rec_train: Recording, spec: ChainSpec, settings) -> str:
 
     Not the number of worker processes (the search is the same with any)
     nor the stop check; the round-off probe is in (it perturbs the samples
-    again inside :func:`~hyst_id.identification.identify`).
+    again inside :func:`~hyst_id.identification.identify`). Nor
+    ``settings.more_starts``: a quick search has no global phase, and
+    :func:`baseline_starts` gives identify more starts only with one.
     """
     h = hashlib.sha1()
     for a in (rec_train.t_s, rec_train.command, rec_train.measurement, spec.bounds):

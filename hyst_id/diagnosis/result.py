@@ -64,14 +64,17 @@ class DiagnoseSettings:
         baseline predict the held-out part (20 do not reach it;
         ``bench/diagnosis_hops.py``). The tests' short settings take 20.
     more_starts : bool
-        The baseline's and the whole record's identifications (those with a
-        global phase) build more chains from the data when the usual ones
-        stop above the floor (identify's ``more_starts``). Off by default:
-        on 75 recordings of the blind family it took the physics claims off
-        the two clean recordings that had them (#59, #63), moved two verdicts
-        on recordings with effects the wrong way (#9 saturation -> friction,
-        #23 static_nonlinearity -> creep) and made the median diagnosis 1.7 x
-        slower (docs/diagnosis.md).
+        The identifications with a global phase (the baseline's, the
+        re-identifications of :mod:`hyst_id.diagnosis.refit`, the whole
+        record's) build more chains from the data when the usual ones stop
+        above the floor (identify's ``more_starts``; the quick searches and
+        the four structured starts of the composed model stay as they are).
+        Off by default: on 75 recordings of the blind family it took the
+        physics claims off the two clean recordings that had them (#59,
+        #63), moved three verdicts on recordings with effects (#9 saturation
+        -> friction, #23 static_nonlinearity + dead_time -> creep, #13
+        unknown -> gain_drift) and made the median diagnosis 1.7 x slower
+        (docs/diagnosis.md).
     should_stop : callable, optional
         Passed to the baseline's identifications (``identify(should_stop=...)``:
         looked at before each jump of hopping and each generation of an

@@ -22,8 +22,9 @@ The stage's modules, in pipeline order:
 :mod:`.domains`           search domains from the data (any units) or presets
 :mod:`.refine`            local least-squares polish after the global search
 :mod:`.gauge`             the chain's gauge freedom and its canonical form
-:mod:`.driver`            :func:`identify`: seeds, GAASS, refinement, restarts,
-                          conventions
+:mod:`.driver`            :func:`identify`: seeds, GAASS, refinement, restarts
+:mod:`.incumbent`         the data-built incumbent, the initial state and sensor
+                          hold conventions ranked, the search subset
 :mod:`.global_phase`      differential evolution over the whole box after the
                           seeds: every convention, then longer runs
 :mod:`.model_choice`      H's family chosen on held-out data (``--model auto``)

@@ -37,9 +37,14 @@ from hyst_id.identification.domains import domains_from_data
 from hyst_id.identification.gauge import canonical_gauge, output_sign
 from hyst_id.identification.global_phase import global_phase, global_phases
 from hyst_id.identification.hop import HOP_RUN_ID, hop_with_cost
-from hyst_id.identification.incumbent import best_polished, choose_conventions
-from hyst_id.identification.incumbent import CONVENTION_GAIN, data_incumbent
-from hyst_id.identification.incumbent import rank_conventions, search_subset
+from hyst_id.identification.incumbent import (
+    best_polished,
+    choose_conventions,
+    CONVENTION_GAIN,
+    data_incumbent,
+    rank_conventions,
+    search_subset,
+)
 from hyst_id.identification.quality import assess
 from hyst_id.identification.refine import refine
 from hyst_id.identification.result import Identification, IdentifySettings, SeedRun

@@ -74,7 +74,7 @@ def global_phase(spec: ChainSpec, rec: Recording, settings: IdentifySettings,
     (popsize 15 per parameter, ``tol = 0``); the refinement adds
     ``refine_max_nfev``. Its random stream is drawn from ``(seed, run_id)``.
     On a long record the search sees the sample indices ``subset``
-    (:func:`~hyst_id.identification.driver.search_subset`); the refinement
+    (:func:`~hyst_id.identification.incumbent.search_subset`); the refinement
     and the returned cost use every sample. ``should_stop`` (in this
     process) is looked at after every generation; when it holds,
     :class:`~hyst_id.identification.workers.WorkersStopped` is raised.

@@ -38,6 +38,12 @@ from hyst_id.signals.reversals import reversal_indices
 __all__ = ['best_polished', 'choose_conventions', 'CONVENTION_GAIN', 'data_incumbent',
            'rank_conventions', 'search_subset', 'SHORT_POLISH']
 
+#: Another initial state or hold is taken only below this share of the current cost.
+CONVENTION_GAIN = 0.999
+
+#: Evaluations per parameter (plus one) of the short polish of each data-built start.
+SHORT_POLISH = 8
+
 
 def data_incumbent(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray,
                    measurement: np.ndarray, settings: IdentifySettings,
@@ -51,18 +57,19 @@ def data_incumbent(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray,
     basin that a global search can fall into. When ``floor_percent`` (the
     noise floor's %e_r; identify gives it with ``settings.more_starts``) is
     given and the best of the starts of
-    :data:`~hyst_id.identification.starts.SPLITS` stays above it, the starts
+    :data:`~hyst_id.identification.starts.SPLITS` stays above it (or none of
+    them is feasible), the starts
     of :data:`~hyst_id.identification.starts.MORE_SPLITS` are ranked and
     polished the same way, and the better of the two is returned.
     """
     with threadpool_limits(limits=1):
         best = _incumbent_of(spec, t_s, command, measurement, settings, SPLITS)
-        if (floor_percent is None or best is None
-                or er_percent(best[1], measurement) <= floor_percent):
+        if floor_percent is None or (best is not None
+                                     and er_percent(best[1], measurement) <= floor_percent):
             return best
         more = _incumbent_of(spec, t_s, command, measurement, settings, MORE_SPLITS)
-    if more is None:
-        return best
+    if more is None or best is None:
+        return more if best is None else best
     nfev = best[2] + more[2]
     return (more[0], more[1], nfev) if more[1] < best[1] else (best[0], best[1], nfev)
 
@@ -154,9 +161,10 @@ def rank_conventions(spec: ChainSpec, rec: Recording, incumbent: tuple[np.ndarra
     under the other sensor hold (it only matters with sensor dynamics). With
     ``floor_percent`` (the noise floor's %e_r), :func:`data_incumbent` gets
     it, and where the polished incumbent stays above it the data-built
-    starts are ranked again under that hold too (a basin the other hold's incumbent does not
-    polish into: blind family #59, a clean pressure recording of the
-    reference, 0.1412 against 0.1367 % with the floor at 0.1322 %).
+    starts are ranked again under that hold too (a basin the other hold's
+    incumbent does not polish into: blind family #59, a clean pressure
+    recording of the reference, 0.1412 against 0.1359 % with the floor at
+    0.1349 %, ``bench/start_splits.py``).
     Another convention ranks above the spec's only when it lowers the cost by
     more than 0.1 %, so that a recording where they make no difference keeps
     the defaults. Each entry is ``(spec, (x, cost, nfev))``; the first
@@ -204,10 +212,3 @@ def choose_conventions(spec: ChainSpec, rec: Recording, incumbent: tuple[np.ndar
                        ) -> tuple[ChainSpec, tuple[np.ndarray, float, int]]:
     """The initial state and sensor hold convention that fit best (:func:`rank_conventions`)."""
     return rank_conventions(spec, rec, incumbent, settings)[0]
-
-
-#: Another initial state or hold is taken only below this share of the current cost.
-CONVENTION_GAIN = 0.999
-
-#: Evaluations per parameter (plus one) of the short polish of each data-built start.
-SHORT_POLISH = 8

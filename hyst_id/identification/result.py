@@ -118,9 +118,10 @@ class IdentifySettings:
         other sensor hold (:func:`hyst_id.identification.incumbent.data_incumbent`,
         :func:`~hyst_id.identification.incumbent.rank_conventions`). Off by
         default: in a diagnosis's baseline it took the claims off the two
-        clean blind recordings that had them (#59, #63) but moved two
-        verdicts of recordings with effects the wrong way and made a
-        diagnosis 1.7 x slower (median, 75 recordings; docs/diagnosis.md).
+        clean blind recordings that had them (#59, #63) but moved three
+        verdicts of recordings with effects (two from right to wrong) and
+        made a diagnosis 1.7 x slower (median, 75 recordings;
+        docs/diagnosis.md). Nothing to do with ``refine`` off.
     """
 
     pop_size: int = 10

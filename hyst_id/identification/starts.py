@@ -37,7 +37,7 @@ SPLITS = ((1.0, 0.1), (1.0, 0.5), (0.7, 0.1), (1.4, 0.1))
 
 #: The rest of the grid of widths 0.7, 1.0, 1.4 x the measured one with 10, 30 and 50 % of
 #: it in B, tried by identify's incumbent when the starts of :data:`SPLITS` stop above
-#: the floor (:func:`hyst_id.identification.driver.data_incumbent`). The true chain's basin
+#: the floor (:func:`hyst_id.identification.incumbent.data_incumbent`). The true chain's basin
 #: can be narrow when H and B share the width about evenly: on clean recordings of the
 #: independent reference (bench/blind_family.py #59, #63, #122, #32) the best incumbent
 #: came from one of these (``python bench/start_splits.py``).

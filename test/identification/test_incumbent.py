@@ -17,7 +17,7 @@
 On blind recording #63 of ``bench/blind_family.py`` (independent reference
 simulator, clean pressure, random steps) the four splits of
 :data:`~hyst_id.identification.starts.SPLITS` polish into other basins than
-the true chain's (2.8-2.9 x the floor): the five of
+the true chain's (2.8-2.9 x the floor unperturbed): the five of
 :data:`~hyst_id.identification.starts.MORE_SPLITS` are asked for there. Which
 basin a polish ends in turns on round-off there (``bench/start_splits.py``,
 docs/model.md), so this test checks the rule, not a figure;
@@ -76,3 +76,24 @@ def test_more_splits_only_with_a_floor_and_above_it(monkeypatch):
         asked.clear()
         got = incumbent.data_incumbent(spec, t, v, y, IdentifySettings(), floor)
         assert asked == want and got is not None
+
+
+def test_the_other_hold_ranks_the_starts_again_only_with_a_floor(monkeypatch):
+    """rank_conventions: data-built starts under the other hold only above a given floor."""
+    holds = []
+    real = incumbent.data_incumbent
+
+    def spy(spec, *args):
+        holds.append((spec.initial, spec.hold))
+        return real(spec, *args)
+
+    monkeypatch.setattr(incumbent, 'data_incumbent', spy)
+    t, v, y = _training_part(63)
+    spec = chain_spec('pressure')
+    rec = Recording(t, v, y, 'pressure')
+    first = real(spec, t, v, y, IdentifySettings())
+    for floor, other_hold_runs in ((None, 0), (1e-6, 2)):
+        holds.clear()
+        ranked = incumbent.rank_conventions(spec, rec, first, IdentifySettings(), floor)
+        assert sum(h != spec.hold for _, h in holds) == other_hold_runs
+        assert len(ranked) == 4       # two initial states x two holds
