@@ -166,7 +166,9 @@ def draw(index: int) -> dict:
     return {'index': index, 'channel': channel, 'excitation': kind, 'dt_s': dt,
             'effects': effects, 'magnitudes': mags, 't': t, 'command': a * v + b,
             'measurement': k * y + zero, 'sensor_zero': zero,
-            'noise_percent_of_span': 100.0 * sigma / span}
+            'noise_percent_of_span': 100.0 * sigma / span,
+            # the reference chain's parameters, for the command before its affine map
+            'chain_params': p, 'reference_command': v}
 
 
 def run(index: int, workers: int = 1, more_starts: bool = False) -> dict:

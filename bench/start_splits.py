@@ -26,7 +26,8 @@ alone (no floor given: identify's default), and with the noise floor given
 (the starts of :data:`~hyst_id.identification.starts.MORE_SPLITS` too while
 the four stay above it: as identify runs it with ``more_starts``), as %e_r
 and as a multiple of the training part's floor; which single split of the
-nine reaches the best, and the seconds each took. Under
+nine reaches the best, and the seconds each took; and what the reference's own
+parameters score in the chain under that hold (column ``truth``). Under
 ``HYST_ID_ROUNDOFF_PROBE=k`` the training part is perturbed at round-off
 level first, as identify perturbs what it is given.
 """
@@ -78,7 +79,8 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument('--indices', type=int, nargs='+', default=list(DEFAULT_INDICES))
     args = ap.parse_args(argv)
-    print(f'{"#":>4} {"channel":9} {"hold":7} {"floor":>7} {"4 splits":>14} {"as identify":>14}'
+    print(f'{"#":>4} {"channel":9} {"hold":7} {"floor":>7} {"truth":>14} {"4 splits":>14} '
+          f'{"as identify":>14}'
           f'  best single split   s (4 / as identify)')
     for i in args.indices:
         case = blind_family.draw(i)
@@ -94,6 +96,13 @@ def main(argv: list[str] | None = None) -> int:
         floor = noise_floor_percent(y)
         for hold in (HOLDS if case['channel'] != 'position' else HOLDS[:1]):
             spec = replace(chain_spec(case['channel']), hold=hold)
+            # the reference's own parameters (a band of 0 included), on its command before
+            # the affine map, with the calibration fitted by least squares
+            s = spec.signal(spec.from_dict(case['chain_params']), t,
+                            case['reference_command'][:n], validate=False)
+            kb = np.linalg.lstsq(np.column_stack([s, np.ones_like(s)]), y, rcond=None)[0]
+            truth = y - (kb[0] * s + kb[1])
+            er_truth = 100.0 * float(np.sqrt(np.sum(truth ** 2) / np.sum(y ** 2)))
             t0 = time.perf_counter()
             old = _incumbent(spec, t, v, y, None)
             t1 = time.perf_counter()
@@ -102,6 +111,7 @@ def main(argv: list[str] | None = None) -> int:
             single = [(_incumbent(spec, t, v, y, None, (s,)), s) for s in SPLITS + MORE_SPLITS]
             best = min(single, key=lambda z: z[0] if np.isfinite(z[0]) else np.inf)
             print(f'{i:>4} {case["channel"]:9} {hold:7} {floor:7.4f} '
+                  f'{er_truth:7.4f} {er_truth / floor:5.2f}x '
                   f'{old:7.4f} {old / floor:5.2f}x {new:7.4f} {new / floor:5.2f}x  '
                   f'{best[1]!s:18} {t1 - t0:4.1f} / {t2 - t1:4.1f}')
     return 0
