@@ -531,6 +531,10 @@ def main() -> int:
         return 0
     text = summary(rows, how)
     print(text)
+    if args.indices:      # against the documented run, on the same recordings
+        documented = json.loads((ROOT / 'docs' / 'diagnosis_blind.json').read_text())
+        print('against docs/diagnosis_blind.json:\n' + moved(documented, rows) + '\n'
+              + time_ratio(documented, rows, args.indices))
     if full:
         (ROOT / 'docs' / 'diagnosis_blind.json').write_text(json.dumps(
             [{key: v for key, v in r.items() if key != 'code'} for r in rows], indent=1))

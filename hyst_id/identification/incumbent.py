@@ -68,10 +68,11 @@ def data_incumbent(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray,
                                      and er_percent(best[1], measurement) <= floor_percent):
             return best
         more = _incumbent_of(spec, t_s, command, measurement, settings, MORE_SPLITS)
-    if more is None or best is None:
-        return more if best is None else best
-    nfev = best[2] + more[2]
-    return (more[0], more[1], nfev) if more[1] < best[1] else (best[0], best[1], nfev)
+    found = [r for r in (best, more) if r is not None]
+    if not found:
+        return None
+    x, fun, _ = min(found, key=lambda r: r[1])     # the four's on a tie
+    return x, fun, sum(r[2] for r in found)
 
 
 def _incumbent_of(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray,
@@ -190,14 +191,12 @@ def rank_conventions(spec: ChainSpec, rec: Recording, incumbent: tuple[np.ndarra
                 trial = replace(base, hold=hold)
                 x, fun, k = refine(trial, x0, *args, max_nfev=settings.refine_max_nfev)
                 nfev += k
-                if floor_percent is None or er_percent(fun, rec.measurement) <= floor_percent:
-                    ranked.append((trial, (x, float(fun), 0)))
-                    continue
-                found = data_incumbent(trial, *args, settings, floor_percent)
-                if found is not None:
-                    nfev += found[2]
-                    if found[1] < fun:
-                        x, fun = found[0], found[1]
+                if floor_percent is not None and er_percent(fun, rec.measurement) > floor_percent:
+                    found = data_incumbent(trial, *args, settings, floor_percent)
+                    if found is not None:
+                        nfev += found[2]
+                        if found[1] < fun:
+                            x, fun = found[0], found[1]
                 ranked.append((trial, (x, float(fun), 0)))
     clearly = [e for e in ranked[1:] if e[1][1] < CONVENTION_GAIN * incumbent[1]]
     winner = min(clearly, key=lambda e: e[1][1]) if clearly else ranked[0]
