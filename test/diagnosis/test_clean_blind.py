@@ -42,8 +42,9 @@ import blind_family  # noqa: E402, I100
 
 __all__: list[str] = []
 
-#: Baseline held-out %e_r over its floor: measured 1.03-1.04 x on #59 unperturbed and
-#: under HYST_ID_ROUNDOFF_PROBE=1, 2, 3 with more starts (2026-11-29); 1.19 x without.
+#: Baseline judged held-out %e_r over its floor: measured 1.029-1.036 x on #59 unperturbed
+#: and under HYST_ID_ROUNDOFF_PROBE=1, 2, 3 with more starts, verdict none in all four
+#: (2026-11-29); 1.19 x without.
 BASELINE_WITHIN = 1.1
 
 
