@@ -53,15 +53,15 @@ from typing import Callable
 import numpy as np
 from threadpoolctl import threadpool_limits
 
-from hyst_id.diagnosis.baseline import baseline_starts, whole_record_er
+from hyst_id.diagnosis.baseline import whole_record_er
 from hyst_id.diagnosis.blocked_cv import BlockedCV, confirmed, split_record
+from hyst_id.diagnosis.challenge import chain_fit, challenge, withdrawn_note
 from hyst_id.diagnosis.control import drop_superseded, equivalent_chain, null_control
 from hyst_id.diagnosis.control import recheck
 from hyst_id.diagnosis.empirical import empirical_block
 from hyst_id.diagnosis.locate import LEVEL_TREND_T, Localization, locate, noise_std
 from hyst_id.diagnosis.mechanisms import get_mechanisms
 from hyst_id.diagnosis.mechanisms.base import Context, Mechanism
-from hyst_id.diagnosis.model import ComposedModel
 from hyst_id.diagnosis.refit import contest
 from hyst_id.diagnosis.result import DiagnoseSettings, Diagnosis, Finding
 from hyst_id.diagnosis.select import (
@@ -70,14 +70,13 @@ from hyst_id.diagnosis.select import (
     close_calls,
     Comparison,
     Data,
-    evaluate,
     FitResult,
     hold_calls,
     round_record,
 )
-from hyst_id.diagnosis.trial import polish_all, try_all
+from hyst_id.diagnosis.trial import try_all
 from hyst_id.errors import ConfigError, RecordingError
-from hyst_id.identification.chains import chain_spec, ChainSpec, HOLDS
+from hyst_id.identification.chains import chain_spec, ChainSpec
 from hyst_id.io.recording import Recording, roundoff_probe, validate_recording
 from hyst_id.signals.noise import floor_percent
 from hyst_id.signals.reversals import period_s
@@ -221,19 +220,7 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
                 judged=inside_rows(v, n_train))
     say(f'baseline: identify (GAASS x {len(settings.seeds)} seeds, global phase) twice on the '
         f'first {n_train} samples')
-    x_fits, starts = baseline_starts(rec_train, spec, settings)
-    # a channel with a sensor has dynamics from the start: its hold convention is chosen
-    # here, on the training error (a position chain is static until a filter block joins)
-    holds = HOLDS if rec.channel != 'position' else HOLDS[:1]
-    pairs = [(model, x0) for model in [ComposedModel(rec.channel, [], ctx, spec.bounds, hold=h)
-                                       for h in holds] for x0 in x_fits + starts]
-    polished = sorted((got + (x0, model) for got, (model, x0) in zip(
-        polish_all(pairs, data, 2 * settings.fit_budget, settings.workers), pairs)),
-        key=lambda z: z[1])
-    baseline = evaluate(polished[0][4], data, polished[0][0], polished[0][2])
-    # the neutral data-built starts whose basins fitted best seed the mechanism fits
-    chain_starts = [z[3] for z in polished if any(z[3] is s for s in starts)
-                    and z[4].hold == baseline.model.hold][:2]
+    baseline, chain_starts = chain_fit(rec_train, spec, settings, data, ctx)
     floor_h = floor_percent(y[n_train:], sigma)
     floor_t = floor_percent(y[:n_train], sigma)
     loc0 = locate(t, v_orig, y, baseline.prediction, sigma, n_train, ctx.period_s)
@@ -317,6 +304,15 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
             findings = [f for f in findings if f.mechanism not in dropped]
             _refresh_values(findings, mechs, current, ctx, v_orig)
             loc = locate(t, v_orig, y, current.prediction, sigma, n_train, ctx.period_s)
+    withdrawn: list[str] = []   # claims that the wider chain alone does as well as
+    if findings:
+        wider = challenge(current, baseline, rec_train, spec, settings, data, ctx, say)
+        if wider is not None:
+            ids = [f.mechanism for f in findings]
+            say(f"{' and '.join(ids)} withdrawn: the chain alone, searched wider, does as well")
+            notes.append(withdrawn_note(ids, current, wider[0], wider[1], data))
+            findings, current, withdrawn = [], wider[0], ids
+            loc = locate(t, v_orig, y, current.prediction, sigma, n_train, ctx.period_s)
     _final_corrections(findings, mechs, current, ctx, v_orig)
     final_loc = loc if current is not baseline else loc0
     gain_call(findings, final_loc, {m.id for m in mechs})
@@ -325,6 +321,8 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
         say('empirical block: what a model could still gain')
         empirical = empirical_block(t, v_orig, y, current.prediction, n_train, ctx.period_s)
     extra = {} if current is baseline else {'blocked_cv': blocked.confirm(baseline, current)}
+    if withdrawn:
+        extra['withdrawn'] = withdrawn
     held = [f for f in findings if confirmed(f.blocked_cv)]
     if held:
         verdict = held[0].mechanism

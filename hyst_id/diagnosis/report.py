@@ -203,6 +203,13 @@ def format_diagnosis(d: Any) -> str:
                          'did not pin the chain down (the held-out command goes where the '
                          "training's did not, along the loop); judged on this split alone "
                          'the question is undecided.')
+        elif d.extra.get('withdrawn'):
+            ratio = d.final.er_holdout_percent / d.noise_floor_percent
+            lines.append(f"verdict: none - {' and '.join(d.extra['withdrawn'])} improved on "
+                         'the baseline (table below), but the chain alone, searched again with '
+                         'more data-built starts, predicts the held-out part as well (note '
+                         f'below; {ratio:.2f} x the noise floor on held-out data): the baseline '
+                         'had stopped short of its basin, and no physics is missing.')
         else:
             ratio = d.final.er_holdout_percent / d.noise_floor_percent
             lines.append('verdict: none - no mechanism of the library improves the held-out '
@@ -210,7 +217,8 @@ def format_diagnosis(d: Any) -> str:
                          f'({ratio:.2f} x the noise floor on held-out data) is within what '
                          'the noise allows.')
         if d.final is not d.baseline:
-            lines.append(f'final model: the same chain, chosen again (note below): %e_r train '
+            how = ('from a wider search' if d.extra.get('withdrawn') else 'chosen again')
+            lines.append(f'final model: the same chain, {how} (note below): %e_r train '
                          f'{_fmt(d.final.er_train_percent)}, held-out '
                          f'{_fmt(d.final.er_holdout_percent)}')
     if d.findings and d.verdict == 'unknown':

@@ -12,19 +12,25 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
-"""A clean blind recording claims no physics with ``more_starts`` (issue 14).
+"""Clean blind recordings claim no physics (issue 14).
 
-Recording #59 of ``bench/blind_family.py`` (the independent reference
-simulator, no effect put in) is a member of the paper's chain under the
+Recordings #59 and #63 of ``bench/blind_family.py`` (the independent reference
+simulator, no effect put in) are members of the paper's chain under the
 reference's sensor hold. With the default data-built starts (four splits of
-the loop width) the baseline stops at 1.19 x the held-out floor and
-``actuator_dynamics`` fills the gap and is claimed. With
-``DiagnoseSettings(more_starts=True)`` (five more splits, ranked again under
-the other sensor hold: :func:`hyst_id.identification.incumbent.data_incumbent`)
-the baseline reaches the floor and the verdict is ``none``, unperturbed and
-under round-off probes 1, 2 and 3 (measured 2026-11-29). #63, the other clean
-recording with a claim, gets ``none`` too except under probe 3 (dead_time
-again), so it is not asserted here (docs/diagnosis.md).
+the loop width) the baseline stops at 1.19 x and 1.24 x the held-out floor,
+and ``actuator_dynamics`` (#59) and ``dead_time`` (#63) filled the gap. Two
+ways now take those claims off:
+
+* by default, the challenge (:mod:`hyst_id.diagnosis.challenge`): a claim
+  made against a baseline within 1.5 x the floor must beat the chain alone
+  searched again with more data-built starts; on both it does not, and the
+  verdict is ``none``, unperturbed and under round-off probes 1, 2 and 3
+  (measured 2026-11-29, see ``FINAL_WITHIN``; under the probes the baseline
+  of #59 reaches the floor by itself);
+* ``DiagnoseSettings(more_starts=True)`` (five more splits, ranked again under
+  the other sensor hold: :func:`hyst_id.identification.incumbent.data_incumbent`),
+  with which #59's baseline itself reaches the floor, unperturbed and under
+  probes 1, 2 and 3.
 """
 
 from __future__ import annotations
@@ -46,6 +52,28 @@ __all__: list[str] = []
 #: and under HYST_ID_ROUNDOFF_PROBE=1, 2, 3 with more starts, verdict none in all four
 #: (2026-11-29); 1.19 x without.
 BASELINE_WITHIN = 1.1
+
+#: Final judged held-out %e_r over its floor with the default settings, verdict none in
+#: every run: #59 1.03, 1.04, 1.04, 1.03 x and #63 1.02, 1.01, 1.08, 1.01 x unperturbed and
+#: under HYST_ID_ROUNDOFF_PROBE=1, 2, 3 (2026-11-29; under the probes the baselines reach
+#: 1.0 x on #59 and 1.0, 1.6, 1.6 x on #63). The claims' finals were 1.04 x: the verdict is
+#: what tells; this bound only keeps the final model near the floor.
+FINAL_WITHIN = 1.2
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize('index', [59, 63])
+def test_a_clean_reference_recording_gets_verdict_none(index):
+    """No finding at all, and a final model at the floor on the judged held-out part."""
+    case = blind_family.draw(index)
+    assert case['effects'] == []
+    rec = Recording(case['t'], case['command'], case['measurement'], case['channel'],
+                    source=f'blind #{index}')
+    d = diagnose(rec, settings=DiagnoseSettings(workers=1))
+    assert d.verdict == 'none', d.report()
+    assert d.findings == [], d.report()
+    j = d.extra['judged_holdout']
+    assert j['final_er_percent'] <= FINAL_WITHIN * j['noise_floor_percent'], d.report()
 
 
 @pytest.mark.slow
