@@ -202,9 +202,9 @@ class IdentificationJob(BackgroundJob):
 class DiagnosisJob(BackgroundJob):
     """:func:`hyst_id.diagnosis.diagnose` of one recording in a worker thread.
 
-    ``train_fraction``, ``seeds`` (how many, from 0), ``generations``, ``hops``
-    and ``mechanisms`` (ids, comma-separated or a sequence; empty = all) set the
-    :class:`~hyst_id.diagnosis.DiagnoseSettings`; ``kwargs`` go to
+    ``train_fraction``, ``seeds`` (how many, from 0), ``generations``, ``hops``,
+    ``more_starts`` and ``mechanisms`` (ids, comma-separated or a sequence; empty
+    = all) set the :class:`~hyst_id.diagnosis.DiagnoseSettings`; ``kwargs`` go to
     ``diagnose`` (e.g. ``spec``). A cancel stops it at the next step it
     reports; ``step`` is the last step reported.
     """
@@ -213,14 +213,15 @@ class DiagnosisJob(BackgroundJob):
 
     def __init__(self, rec: Recording, *, train_fraction: float = 0.7, seeds: int = 2,
                  generations: int = 200, mechanisms: str | tuple[str, ...] = '',
-                 hops: int = 100, **kwargs: Any) -> None:
+                 hops: int = 100, more_starts: bool = False, **kwargs: Any) -> None:
         super().__init__()
         self.rec, self.kwargs = rec, kwargs
         if isinstance(mechanisms, str):
             mechanisms = tuple(m.strip() for m in mechanisms.split(',') if m.strip())
         self.options = {'train_fraction': float(train_fraction),
                         'seeds': tuple(range(int(seeds))), 'generations': int(generations),
-                        'mechanisms': tuple(mechanisms) or None, 'hops': int(hops)}
+                        'mechanisms': tuple(mechanisms) or None, 'hops': int(hops),
+                        'more_starts': bool(more_starts)}
         self.step = 'starting'
         self.start()
 

@@ -301,7 +301,8 @@ class Identifier(HystNode):
             self.diag_job = DiagnosisJob(
                 validate_recording(rec), train_fraction=self.p('diagnose_train_fraction'),
                 seeds=self.p('diagnose_seeds'), generations=self.p('diagnose_generations'),
-                mechanisms=self.p('diagnose_mechanisms'), hops=self.p('diagnose_hops'))
+                mechanisms=self.p('diagnose_mechanisms'), hops=self.p('diagnose_hops'),
+                more_starts=self.p('diagnose_more_starts'))
         except HystIdError as exc:
             self._fail(f'cannot diagnose ({why}): {exc}')
             return False, str(exc)

@@ -203,6 +203,7 @@ def test_diagnose_service_publishes_findings_and_json(ctx):
     ident = _make(ctx, Identifier, parameter_overrides=FAST + [
         Parameter('diagnose_seeds', value=1), Parameter('diagnose_generations', value=20),
         Parameter('diagnose_hops', value=20),
+        Parameter('diagnose_more_starts', value=True), Parameter('more_starts', value=True),
         Parameter('diagnose_mechanisms', value='offset_drift, sensor_lag')])
     caller = _make(ctx, Node, 'caller')
     diag = caller.create_client(Trigger, '/identifier/diagnose')
@@ -218,6 +219,8 @@ def test_diagnose_service_publishes_findings_and_json(ctx):
     assert _spin_until(ctx, future.done, timeout=5.0)
     assert future.result().success, future.result().message
     assert ident.diag_job.options['hops'] == 20              # diagnose_hops reaches it
+    assert ident.diag_job.options['more_starts'] is True     # and diagnose_more_starts
+    assert ident.settings().more_starts is True              # identify's own more_starts
     assert _spin_until(ctx, lambda: bool(docs), timeout=120.0), ident.last_error
     assert docs[-1]['verdict'] == 'offset_drift'
 

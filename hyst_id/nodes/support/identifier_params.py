@@ -38,7 +38,7 @@ def identify_settings(p: Callable[[str], Any]) -> IdentifySettings:
         generations=p('generations'), c=p('c'), xi=p('xi'), workers=p('workers'),
         refine=p('refine'), restarts=p('restarts'),
         er_bound_percent=bound if bound > 0 else None, global_evals=p('global_evals'),
-        global_runs=p('global_runs'), hops=p('hops'))
+        global_runs=p('global_runs'), hops=p('hops'), more_starts=p('more_starts'))
 
 
 def default_params_out() -> Path:
@@ -86,6 +86,9 @@ PARAMS = [
     Param('global_runs', 14, 'most runs of the global phase (0 = none)', low=0, high=1000),
     Param('hops', 100, 'when the best seed ends between 1.1 and 4 x the noise floor, the most '
           'jumps of basin hopping from it (0 = none)', low=0, high=100000),
+    Param('more_starts', False, 'when the chains built from the data stop above the noise '
+          'floor, five more ways of sharing the loop width between H and the backlash '
+          '(identify --more-starts: finds narrow basins, costs time)'),
     Param('domains', 'auto', "search domains: 'auto' (from the data), 'paper', or a YAML "
           'file of name: [low, high]'),
     Param('model', 'tk', "H's family: 'tk' (the paper's piecewise-linear loop), 'smooth' "
@@ -119,6 +122,9 @@ PARAMS = [
     Param('diagnose_hops', 100, "most jumps of basin hopping in the diagnosis baseline's "
           'identifications (20: about 40 % faster when the chain lacks physics)', low=0,
           high=100000),
+    Param('diagnose_more_starts', False, "identify's more_starts in the diagnosis baseline's "
+          'identifications (diagnose --more-starts; off: a claim that gains little is '
+          'challenged by such a search anyway)'),
     Param('diagnose_mechanisms', '', "comma-separated mechanism ids to test ('' = the whole "
           'library)'),
     *SLIDING_PARAMS,
