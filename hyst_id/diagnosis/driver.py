@@ -32,7 +32,8 @@
    (:mod:`hyst_id.diagnosis.control`); when none is accepted but a chain as
    good on the training part predicts the held-out part better, that chain is
    taken and the round runs again; repeats once more if the residual still
-   has structure;
+   has structure; claims made against a baseline near its floor then face
+   the chain alone searched wider (:mod:`hyst_id.diagnosis.challenge`);
 4. returns a :class:`Diagnosis` whose :meth:`~Diagnosis.to_dict` is the
    ``--json`` document and whose :meth:`~Diagnosis.report` is the text report.
 
@@ -306,7 +307,8 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
             loc = locate(t, v_orig, y, current.prediction, sigma, n_train, ctx.period_s)
     withdrawn: list[str] = []   # claims that the wider chain alone does as well as
     if findings:
-        wider = challenge(current, baseline, rec_train, spec, settings, data, ctx, say)
+        wider = challenge(current, baseline, rec_train, spec, settings, data, ctx, say,
+                          split_short=blocked.split_short)
         if wider is not None:
             ids = [f.mechanism for f in findings]
             say(f"{' and '.join(ids)} withdrawn: the chain alone, searched wider, does as well")

@@ -163,6 +163,16 @@ def _unknown_lines(d: Any) -> list[str]:
                            sorted(train_only, key=lambda z: z[1]))
 
 
+def _withdrawn_lines(d: Any) -> list[str]:
+    """A sentence under the verdict when the challenge withdrew the rounds' claims."""
+    ids = d.extra.get('withdrawn') or []
+    if not ids:
+        return []
+    return [f"  - {' and '.join(ids)} improved on the baseline (table below) and was withdrawn: "
+            'the chain alone, searched again with more data-built starts, predicts the judged '
+            'held-out part as well (note below)']
+
+
 def format_diagnosis(d: Any) -> str:
     """Plain-text report: where, what physics, fitted block, held-out errors, tests."""
     t = d.t_s
@@ -192,6 +202,7 @@ def format_diagnosis(d: Any) -> str:
                          f'({ratio:.2f} x the noise floor on held-out data) and no mechanism '
                          'of the library explains it (table below); where it shows is above.')
             lines += [f'  - {x}' for x in _unknown_lines(d)]
+            lines += _withdrawn_lines(d)
         elif 'whole_record' in d.extra:
             ratio = d.final.er_holdout_percent / d.noise_floor_percent
             w = d.extra['whole_record']
@@ -203,6 +214,7 @@ def format_diagnosis(d: Any) -> str:
                          'did not pin the chain down (the held-out command goes where the '
                          "training's did not, along the loop); judged on this split alone "
                          'the question is undecided.')
+            lines += _withdrawn_lines(d)
         elif d.extra.get('withdrawn'):
             ratio = d.final.er_holdout_percent / d.noise_floor_percent
             lines.append(f"verdict: none - {' and '.join(d.extra['withdrawn'])} improved on "
@@ -265,12 +277,14 @@ def format_diagnosis(d: Any) -> str:
                                                if not fl.structured else
                                                'still structured: ' + '; '.join(
                                                    fl.summary(unit)[1:3])))
+    withdrawn = set(d.extra.get('withdrawn', ()))
     for r in d.rounds:
         lines += ['', f'mechanisms tested (round {r["round"]}):',
                   f'  {"mechanism":22s}{"held-out %e_r":>14s}{"gain":>8s}{"share":>7s}'
                   f'{"dBIC":>9s}{"z":>9s}  status']
         for c in sorted(r['candidates'], key=lambda c: c['er_holdout_percent']):
-            status = c['status'] + (' (chosen)' if c['chosen'] else '')
+            status = c['status'] + ((' (chosen, withdrawn)' if c['mechanism'] in withdrawn
+                                     else ' (chosen)') if c['chosen'] else '')
             lines.append(f'  {c["mechanism"]:22s}{c["er_holdout_percent"]:14.4g}'
                          f'{100 * c["holdout_gain"]:7.0f}%{100 * c["explained_share"]:6.0f}%'
                          f'{c["delta_bic"]:9.0f}{c["holdout_z"]:9.1f}  {status}')

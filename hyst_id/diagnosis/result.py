@@ -74,7 +74,9 @@ class DiagnoseSettings:
         #63), moved three verdicts on recordings with effects (#9 saturation
         -> friction, #23 static_nonlinearity + dead_time -> creep, #13
         unknown -> gain_drift) and made the median diagnosis 1.7 x slower
-        (docs/diagnosis.md).
+        (docs/diagnosis.md). Off, a diagnosis still runs such a search where
+        blocks were accepted against a baseline near its floor
+        (:mod:`hyst_id.diagnosis.challenge`); on, there is no such challenge.
     should_stop : callable, optional
         Passed to the baseline's identifications (``identify(should_stop=...)``:
         looked at before each jump of hopping and each generation of an

@@ -61,7 +61,7 @@ def _fits(bias_sigmas):
     return data, final, baseline
 
 
-def _run(monkeypatch, data, final, baseline, wider, settings=None):
+def _run(monkeypatch, data, final, baseline, wider, settings=None, split_short=False):
     calls = []
 
     def fake_chain_fit(rec_train, spec, settings, data, ctx):
@@ -71,7 +71,8 @@ def _run(monkeypatch, data, final, baseline, wider, settings=None):
         return wider, []
 
     monkeypatch.setattr(challenge_module, 'chain_fit', fake_chain_fit)
-    got = challenge(final, baseline, None, None, settings or DiagnoseSettings(), data, None)
+    got = challenge(final, baseline, None, None, settings or DiagnoseSettings(), data, None,
+                    split_short=split_short)
     return got, calls
 
 
@@ -93,6 +94,31 @@ def test_the_claims_stand_when_the_wider_chain_finds_nothing_better(monkeypatch)
     got, calls = _run(monkeypatch, data, final, baseline, baseline)
     assert calls == [True]
     assert got is None
+
+
+def test_a_chain_better_on_training_only_leaves_the_claims_standing(monkeypatch):
+    """The final model predicts the held-out part better: a training-only win does not count."""
+    data, final, baseline = _fits(0.7)
+    wider = _fit(data, baseline.prediction, n_free=10)
+    wider.sse_train = 0.5 * final.sse_train      # fits the training part far better (BIC)
+    got, calls = _run(monkeypatch, data, final, baseline, wider)
+    assert calls == [True] and got is None
+
+
+def test_the_better_of_the_wider_search_and_the_baseline_is_the_chain(monkeypatch):
+    """A wider search that fits the training part worse than the baseline does not replace it."""
+    data, final, baseline = _fits(0.7)
+    worse = _fit(data, final.prediction + 0.05 * SIGMA, n_free=10)   # predicts as well...
+    worse.sse_train = 2.0 * baseline.sse_train                         # ...but fits worse
+    got, calls = _run(monkeypatch, data, final, baseline, worse)
+    assert calls == [True] and got is None       # against the baseline the claims stand
+
+
+def test_a_short_split_is_not_challenged(monkeypatch):
+    """Rounds decided over time blocks are not overruled by the split alone."""
+    data, final, baseline = _fits(0.7)
+    got, calls = _run(monkeypatch, data, final, baseline, None, split_short=True)
+    assert got is None and calls == []
 
 
 @pytest.mark.parametrize('bias_sigmas', [2.0, 5.0])
@@ -119,7 +145,7 @@ def test_a_diagnosis_whose_claims_fall_says_so(monkeypatch):
 
     seen = []
 
-    def fall(final, baseline, rec_train, spec, settings, data, ctx, say):
+    def fall(final, baseline, rec_train, spec, settings, data, ctx, say, split_short):
         seen.append(final.ids)
         wider = replace(final, ids=())          # a chain alone that predicts as well
         return wider, compare(wider, final, data, 'final model', settings.criteria)
@@ -134,3 +160,4 @@ def test_a_diagnosis_whose_claims_fall_says_so(monkeypatch):
     assert 'verdict: none - dead_time improved on the baseline' in text
     assert 'dead_time accepted in the rounds and withdrawn at the end' in text
     assert 'final model: the same chain, from a wider search' in text
+    assert 'accepted (chosen, withdrawn)' in text
