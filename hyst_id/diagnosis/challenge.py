@@ -43,7 +43,7 @@ the time: docs/diagnosis.md).
 from __future__ import annotations
 
 from dataclasses import replace
-from typing import Callable
+from typing import Callable, TYPE_CHECKING
 
 import numpy as np
 
@@ -56,6 +56,9 @@ from hyst_id.diagnosis.trial import polish_all
 from hyst_id.identification.chains import ChainSpec, HOLDS
 from hyst_id.io.recording import Recording
 
+if TYPE_CHECKING:
+    from hyst_id.diagnosis.result import DiagnoseSettings
+
 __all__ = ['CHALLENGE_FACTOR', 'chain_fit', 'challenge', 'withdrawn_note']
 
 #: A baseline within this multiple of the judged held-out floor makes its claims face
@@ -65,13 +68,32 @@ __all__ = ['CHALLENGE_FACTOR', 'chain_fit', 'challenge', 'withdrawn_note']
 CHALLENGE_FACTOR = 1.5
 
 
-def chain_fit(rec_train: Recording, spec: ChainSpec, settings, data: Data, ctx: Context
-              ) -> tuple[FitResult, list[np.ndarray]]:
+def chain_fit(rec_train: Recording, spec: ChainSpec, settings: DiagnoseSettings, data: Data,
+              ctx: Context) -> tuple[FitResult, list[np.ndarray]]:
     """The chain alone on the training part, and the data-built starts that fitted best.
 
-    Returns the best polished chain (evaluated on the whole record) and up to
-    two data-built starts of its hold whose basins fitted best (they seed the
-    mechanism fits).
+    Parameters
+    ----------
+    rec_train : Recording
+        The training part, in the model's command units.
+    spec : ChainSpec
+        The chain and its search domains.
+    settings : DiagnoseSettings
+        The baseline's search (:func:`~hyst_id.diagnosis.baseline.baseline_starts`)
+        and the polish budget.
+    data : Data
+        The whole record (training and held out) the fits are evaluated on.
+    ctx : Context
+        What the composed model needs (channel, times, command scale).
+
+    Returns
+    -------
+    best : FitResult
+        The polished chain that fits the training part best, evaluated on the
+        whole record.
+    chain_starts : list of ndarray
+        Up to two data-built starts of its hold whose basins fitted best (they
+        seed the mechanism fits).
     """
     x_fits, starts = baseline_starts(rec_train, spec, settings)
     # a channel with a sensor has dynamics from the start: its hold convention is chosen
@@ -90,7 +112,7 @@ def chain_fit(rec_train: Recording, spec: ChainSpec, settings, data: Data, ctx: 
 
 
 def challenge(final: FitResult, baseline: FitResult, rec_train: Recording, spec: ChainSpec,
-              settings, data: Data, ctx: Context,
+              settings: DiagnoseSettings, data: Data, ctx: Context,
               say: Callable[[str], None] = lambda msg: None, *, split_short: bool = False
               ) -> tuple[FitResult, Comparison] | None:
     """The wider chain alone when the final model's blocks do not beat it, else None.
@@ -137,7 +159,24 @@ def challenge(final: FitResult, baseline: FitResult, rec_train: Recording, spec:
 
 def withdrawn_note(ids: list[str], final: FitResult, wider: FitResult, comp: Comparison,
                    data: Data) -> str:
-    """Why the claims ``ids`` were withdrawn (:func:`challenge` found the chain enough)."""
+    """Why the claims ``ids`` were withdrawn (:func:`challenge` found the chain enough).
+
+    Parameters
+    ----------
+    ids : list of str
+        The withdrawn mechanisms.
+    final, wider : FitResult
+        The model with the blocks, and the chain that replaces it.
+    comp : Comparison
+        ``final`` against ``wider`` (:func:`challenge`'s second item).
+    data : Data
+        The record, for the judged errors and the floor.
+
+    Returns
+    -------
+    str
+        The sentence the report's notes carry.
+    """
     n, judged = data.n_train, data.judged_er_percent
     return (f"{' and '.join(ids)} accepted in the rounds and withdrawn at the end: the "
             f'baseline had stopped within {CHALLENGE_FACTOR} x the floor, and the chain alone, '
