@@ -157,18 +157,18 @@ def challenge(final: FitResult, baseline: FitResult, rec_train: Recording, spec:
     return wider, comp
 
 
-def withdrawn_note(ids: list[str], final: FitResult, wider: FitResult, comp: Comparison,
-                   data: Data) -> str:
+def withdrawn_note(ids: list[str], wider: FitResult, comp: Comparison, data: Data) -> str:
     """Why the claims ``ids`` were withdrawn (:func:`challenge` found the chain enough).
 
     Parameters
     ----------
     ids : list of str
         The withdrawn mechanisms.
-    final, wider : FitResult
-        The model with the blocks, and the chain that replaces it.
+    wider : FitResult
+        The chain that replaces the model with the blocks.
     comp : Comparison
-        ``final`` against ``wider`` (:func:`challenge`'s second item).
+        The model with the blocks (``comp.fit``) against ``wider``
+        (:func:`challenge`'s second item).
     data : Data
         The record, for the judged errors and the floor.
 
@@ -177,7 +177,7 @@ def withdrawn_note(ids: list[str], final: FitResult, wider: FitResult, comp: Com
     str
         The sentence the report's notes carry.
     """
-    n, judged = data.n_train, data.judged_er_percent
+    n, judged, final = data.n_train, data.judged_er_percent, comp.fit
     return (f"{' and '.join(ids)} accepted in the rounds and withdrawn at the end: the "
             f'baseline had stopped within {CHALLENGE_FACTOR} x the floor, and the chain alone, '
             f'searched again with more data-built starts, predicts the judged held-out part '

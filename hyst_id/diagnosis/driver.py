@@ -312,7 +312,7 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
         if wider is not None:
             ids = [f.mechanism for f in findings]
             say(f"{' and '.join(ids)} withdrawn: the chain alone, searched wider, does as well")
-            notes.append(withdrawn_note(ids, current, wider[0], wider[1], data))
+            notes.append(withdrawn_note(ids, *wider, data))
             findings, current, withdrawn = [], wider[0], ids
             loc = locate(t, v_orig, y, current.prediction, sigma, n_train, ctx.period_s)
     _final_corrections(findings, mechs, current, ctx, v_orig)

@@ -85,7 +85,7 @@ def test_the_claims_fall_when_the_wider_chain_predicts_as_well(monkeypatch):
     assert calls == [True]                     # searched with more_starts
     assert got is not None and got[0] is wider
     assert got[1].holdout_z < 4.0 and not got[1].accepted
-    note = withdrawn_note(['dead_time'], final, wider, got[1], data)
+    note = withdrawn_note(['dead_time'], *got, data)
     assert note.startswith('dead_time accepted in the rounds and withdrawn')
 
 
