@@ -325,10 +325,11 @@ def moved(old: list[dict], new: list[dict]) -> str:
 
 
 def time_ratio(old: list[dict], new: list[dict], indices: list[int] | None = None) -> str:
-    """Median seconds per recording on the recordings both runs have (or ``indices``), a line.
+    """Seconds per recording on the recordings both runs have (or ``indices``), a line.
 
-    The same recordings and code paths on two machines: the ratio is the machines', as long
-    as nothing moved (see :func:`moved`).
+    The median with its ratio, then the sum and the slowest recording of each run. The same
+    recordings and code paths on two machines: the ratio is the machines', as long as
+    nothing moved (see :func:`moved`).
     """
     before = {r['index']: r['seconds'] for r in old}
     pairs = [(before[r['index']], r['seconds']) for r in new if r['index'] in before
@@ -336,8 +337,11 @@ def time_ratio(old: list[dict], new: list[dict], indices: list[int] | None = Non
     if not pairs:
         return 'no recording in both runs'
     was, now = np.median([p[0] for p in pairs]), np.median([p[1] for p in pairs])
+    sums = [sum(p[k] for p in pairs) for k in (0, 1)]
+    slowest = [max(pairs, key=lambda p: p[k])[k] for k in (0, 1)]
     return (f'seconds per recording on the same {len(pairs)} recordings, median: '
-            f'{was:.0f} -> {now:.0f} ({now / was:.1f} x)')
+            f'{was:.0f} -> {now:.0f} ({now / was:.1f} x); sum {sums[0]:.0f} -> {sums[1]:.0f}; '
+            f'max {slowest[0]:.0f} -> {slowest[1]:.0f}')
 
 
 def write_csv(folder: Path, indices: list[int]) -> int:

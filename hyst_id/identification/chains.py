@@ -46,18 +46,19 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 from typing import Callable, Mapping
 
-from numba import njit
 import numpy as np
 
 from hyst_id.errors import ConfigError, InvalidParametersError
-from hyst_id.models.backlash import BACKLASH_NAMES, backlash_step, check_backlash
+from hyst_id.identification.chain_kernels import (fit_affine, sum_squares, tail_costs,
+                                                  tail_feasible_rows, tail_signal)
+from hyst_id.models.backlash import BACKLASH_NAMES, check_backlash
 from hyst_id.models.family import HysteresisFamily
 from hyst_id.models.registry import DEFAULT_FAMILY, get_family
-from hyst_id.models.sensors import (first_order_coefficient, intervals_and_uniform,
-                                    second_order_coefficients)
+from hyst_id.models.sensors import intervals_and_uniform
 
 __all__ = ['CHAIN_NAMES', 'CHANNELS', 'HOLDS', 'INITIAL_STATES', 'PAPER_DOMAINS', 'PARAM_UNITS',
-           'SENSOR_NAMES', 'ChainSpec', 'chain_names', 'chain_spec', 'er_percent', 'param_units']
+           'SENSOR_NAMES', 'ChainResiduals', 'ChainSpec', 'chain_names', 'chain_spec',
+           'er_percent', 'param_units']
 
 CHANNELS = ('position', 'pressure', 'flow')
 #: Sensor-dynamics parameters of each channel.
@@ -96,137 +97,17 @@ PARAM_UNITS = param_units(DEFAULT_FAMILY)
 PAPER_DOMAINS = {**dict(get_family(DEFAULT_FAMILY).paper_domains), **TAIL_PAPER_DOMAINS}
 
 
-@njit(cache=True)
-def _tail_feasible_rows(tail):
-    ok = np.empty(tail.shape[0], dtype=np.bool_)
-    for i in range(tail.shape[0]):
-        good = tail[i, 0] > 0.0 and tail[i, 1] < tail[i, 2]
-        for q in range(tail.shape[1]):
-            if not np.isfinite(tail[i, q]):
-                good = False
-        ok[i] = good
-    return ok
-
-
 def _rows_feasible(family: HysteresisFamily, h: np.ndarray, tail: np.ndarray,
                    paper_frame: bool) -> np.ndarray:
     """Every constraint per row: H's family, B's and the sensor's, the paper's frame-bound ones."""
-    ok = family.feasible_rows(h) & _tail_feasible_rows(tail)
+    ok = family.feasible_rows(h) & tail_feasible_rows(tail)
     return ok & family.paper_frame_rows(h) if paper_frame else ok
-
-
-@njit(cache=True)
-def _tail_signal(u, tail, kind, dt_s, uniform, falling, hold_after, out):
-    """Backlash and sensor dynamics after H's output ``u``, into ``out``.
-
-    B starts on its rising edge, or on its falling one when ``falling``. The
-    sensor input of sample ``j`` is B's output at ``j`` (held over the
-    interval before it), or at ``j - 1`` when ``hold_after`` (held over the
-    interval after it: a sample does not yet see the command of its instant).
-    """
-    m_bl, c_bl, c_br = tail[0], tail[1], tail[2]
-    y = m_bl * (u[0] - (c_bl if falling else c_br))
-    out[0] = y
-    n = u.shape[0]
-    if kind == 0:
-        for j in range(1, n):
-            y = backlash_step(u[j], y, m_bl, c_bl, c_br)
-            out[j] = y
-    elif kind == 1:
-        tau = tail[3]
-        a = first_order_coefficient(dt_s[1], tau)
-        x = y
-        for j in range(1, n):
-            y_prev = y
-            y = backlash_step(u[j], y, m_bl, c_bl, c_br)
-            if not uniform:
-                a = first_order_coefficient(dt_s[j], tau)
-            x = a * x + (1.0 - a) * (y_prev if hold_after else y)
-            out[j] = x
-    else:
-        zeta, omega = tail[3], tail[4]
-        p11, p12, p21, p22 = second_order_coefficients(dt_s[1], zeta, omega)
-        x = y
-        xd = 0.0
-        for j in range(1, n):
-            y_prev = y
-            y = backlash_step(u[j], y, m_bl, c_bl, c_br)
-            if not uniform:
-                p11, p12, p21, p22 = second_order_coefficients(dt_s[j], zeta, omega)
-            e = x - (y_prev if hold_after else y)
-            x = (y_prev if hold_after else y) + p11 * e + p12 * xd
-            xd = p21 * e + p22 * xd
-            out[j] = x
-
-
-@njit(cache=True)
-def _fit_affine(s, y):
-    """Least-squares ``(k, b)`` of ``y ~ k s + b`` and its residual sum of squares.
-
-    Sums in sample order (a fixed order: the same bits on every CPU make).
-    """
-    n = s.shape[0]
-    s_ref = s[0]
-    ss = 0.0
-    sss = 0.0
-    sy = 0.0
-    ssy = 0.0
-    syy = 0.0
-    for j in range(n):
-        sj = s[j] - s_ref
-        ss += sj
-        sss += sj * sj
-        sy += y[j]
-        ssy += sj * y[j]
-        syy += y[j] * y[j]
-    var_s = sss - ss * ss / n
-    cov = ssy - ss * sy / n
-    var_y = syy - sy * sy / n
-    if var_s <= 1e-300 * max(1.0, sss):
-        return 0.0, sy / n, max(var_y, 0.0)
-    k = cov / var_s
-    b = (sy - k * ss) / n - k * s_ref
-    return k, b, max(var_y - k * cov, 0.0)
-
-
-@njit(cache=True)
-def _sse(s, y, k, b):
-    acc = 0.0
-    for j in range(s.shape[0]):
-        r = y[j] - (k * s[j] + b)
-        acc += r * r
-    return acc
-
-
-@njit(cache=True)
-def _tail_costs(u, tail, ok, kind, y, dt_s, uniform, falling, hold_after, profile, k_fixed,
-                b_fixed, costs):
-    """Cost J (Eq. 6) of every row whose H output is ``u[i]``; infeasible rows cost inf."""
-    s = np.empty(y.shape[0])
-    for i in range(u.shape[0]):
-        if not ok[i]:
-            costs[i] = np.inf
-            continue
-        _tail_signal(u[i], tail[i], kind, dt_s, uniform, falling, hold_after, s)
-        if profile:
-            k, b, _ = _fit_affine(s, y)
-            costs[i] = _sse(s, y, k, b)   # second pass: no cancellation
-        else:
-            costs[i] = _sse(s, y, k_fixed, b_fixed)
 
 
 def er_percent(cost_j: float | np.ndarray, measurement: np.ndarray) -> float | np.ndarray:
     """Relative percentage error %e_r (Eq. 7) from the cost J."""
     y = np.ascontiguousarray(measurement, dtype=np.float64)
-    return np.sqrt(np.asarray(cost_j) / _sum_squares(y)) * 100.0
-
-
-@njit(cache=True)
-def _sum_squares(y):
-    acc = 0.0
-    for j in range(y.shape[0]):
-        acc += y[j] * y[j]
-    return acc
+    return np.sqrt(np.asarray(cost_j) / sum_squares(y)) * 100.0
 
 
 #: Largest number of H outputs (candidates x samples) held at once by the population cost.
@@ -374,8 +255,8 @@ class ChainSpec:
                 family.simulate_rows(h, v_h, ok, u)
                 if falling:
                     u = np.ascontiguousarray(u[:, 1:])
-                _tail_costs(u, tail, ok, kind, y, dt, uniform, falling, hold_after, profile,
-                            k, b, costs[a:a + block])
+                tail_costs(u, tail, ok, kind, y, dt, uniform, falling, hold_after, profile,
+                           k, b, costs[a:a + block])
             return costs
 
         return cost
@@ -389,25 +270,38 @@ class ChainSpec:
         """
         p = self.check(params) if validate else np.ascontiguousarray(params, dtype=np.float64)
         v = np.ascontiguousarray(command, dtype=np.float64)
-        dt, uniform = intervals_and_uniform(t_s)
-        u = self.family.simulate(p[:self.n_h], self._h_command(v), validate=False)
+        return self._signal(p, self._h_command(v), intervals_and_uniform(t_s), v.shape[0])
+
+    def _signal(self, p: np.ndarray, v_h: np.ndarray, intervals: tuple[np.ndarray, bool],
+                n: int) -> np.ndarray:
+        u = self.family.simulate(p[:self.n_h], v_h, validate=False)
         if self.falling:
             u = np.ascontiguousarray(u[1:])
-        out = np.empty(v.shape[0])
-        _tail_signal(u, np.ascontiguousarray(p[self.n_h:]), _KIND[self.channel], dt, uniform,
-                     self.falling, self.hold == 'after', out)
+        out = np.empty(n)
+        tail_signal(u, np.ascontiguousarray(p[self.n_h:]), _KIND[self.channel], *intervals,
+                    self.falling, self.hold == 'after', out)
         return out
+
+    def _minus_calibrated(self, s: np.ndarray, y: np.ndarray) -> np.ndarray:
+        k, b = fit_affine(s, y)[:2] if self.profiled else self.calibration
+        return y - (k * s + b)
 
     def residual(self, params: np.ndarray, t_s: np.ndarray, command: np.ndarray,
                  measurement: np.ndarray) -> np.ndarray:
         """Measurement minus chain output, with the calibration profiled if it is."""
         s = self.signal(params, t_s, command)
-        y = np.ascontiguousarray(measurement, dtype=np.float64)
-        if self.profiled:
-            k, b, _ = _fit_affine(s, y)
-        else:
-            k, b = self.calibration
-        return y - (k * s + b)
+        return self._minus_calibrated(s, np.ascontiguousarray(measurement, dtype=np.float64))
+
+    def residual_function(self, t_s: np.ndarray, command: np.ndarray,
+                          measurement: np.ndarray) -> ChainResiduals:
+        """:meth:`residual` on one recording, for parameters already found :meth:`feasible`.
+
+        What every call shares (sample intervals, H's command) is computed once
+        and nothing is validated: the function a least-squares loop calls after
+        its own feasibility test. Returns the same numbers as :meth:`residual`;
+        :meth:`ChainResiduals.rows` gives them for many sets with H run once.
+        """
+        return ChainResiduals(self, t_s, command, measurement)
 
     def fit_calibration(self, params: np.ndarray, t_s: np.ndarray, command: np.ndarray,
                         measurement: np.ndarray) -> tuple[float, float]:
@@ -415,7 +309,7 @@ class ChainSpec:
         if not self.profiled:
             return self.calibration
         s = self.signal(params, t_s, command)
-        k, b, _ = _fit_affine(s, np.ascontiguousarray(measurement, dtype=np.float64))
+        k, b, _ = fit_affine(s, np.ascontiguousarray(measurement, dtype=np.float64))
         return float(k), float(b)
 
     def simulate(self, params: np.ndarray, t_s: np.ndarray, command: np.ndarray,
@@ -454,6 +348,46 @@ class ChainSpec:
         if missing:
             raise ConfigError(f'missing parameters for the {self.channel} chain: {missing}')
         return np.array([float(values[n]) for n in self.names])
+
+
+class ChainResiduals:
+    """:meth:`ChainSpec.residual` of feasible sets on one recording (see ``residual_function``)."""
+
+    def __init__(self, spec: ChainSpec, t_s: np.ndarray, command: np.ndarray,
+                 measurement: np.ndarray) -> None:
+        self.spec = spec
+        self.v = np.ascontiguousarray(command, dtype=np.float64)
+        self.y = np.ascontiguousarray(measurement, dtype=np.float64)
+        self.v_h, self.intervals = spec._h_command(self.v), intervals_and_uniform(t_s)
+
+    def __call__(self, params: np.ndarray) -> np.ndarray:
+        """Residual of one feasible set."""
+        p = np.ascontiguousarray(params, dtype=np.float64)
+        s = self.spec._signal(p, self.v_h, self.intervals, self.v.shape[0])
+        return self.spec._minus_calibrated(s, self.y)
+
+    def rows(self, pop: np.ndarray, ok: np.ndarray) -> list[np.ndarray | None]:
+        """Residual of each row of ``pop`` with ``ok`` true (``None`` for the others).
+
+        H runs once over the rows (its kernel takes each row alone, so every
+        residual has the bits of :meth:`__call__`); the rest row by row.
+        """
+        spec = self.spec
+        pop = np.ascontiguousarray(pop, dtype=np.float64)
+        u = np.empty((pop.shape[0], self.v_h.shape[0]))
+        spec.family.simulate_rows(np.ascontiguousarray(pop[:, :spec.n_h]), self.v_h,
+                                  np.ascontiguousarray(ok, dtype=np.bool_), u)
+        out: list[np.ndarray | None] = []
+        for i in range(pop.shape[0]):
+            if not ok[i]:
+                out.append(None)
+                continue
+            s = np.empty(self.v.shape[0])
+            tail_signal(np.ascontiguousarray(u[i, 1:] if spec.falling else u[i]),
+                        np.ascontiguousarray(pop[i, spec.n_h:]), _KIND[spec.channel],
+                        *self.intervals, spec.falling, spec.hold == 'after', s)
+            out.append(spec._minus_calibrated(s, self.y))
+        return out
 
 
 def _bounds_array(names: tuple[str, ...], bounds, base: np.ndarray | None,

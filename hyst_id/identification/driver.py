@@ -298,7 +298,8 @@ def identify(recording: Recording, *, spec: ChainSpec | None = None,
             raise WorkersStopped('stopped on request while hopping')
         if hopping is not None:
             hopping(jump, jumps, er)
-    first, spent = hop_with_cost(spec, rec, best, settings, floor, on_jump=on_jump)
+    first, spent = hop_with_cost(spec, rec, best, settings, floor, on_jump=on_jump,
+                                 n_workers=n_workers)
     hopped = [first] if first is not None else []
     at_floor = bool(hopped) and hopped[0].er_percent <= settings.global_factor * floor
     improved = global_phases(spec, others, rec, settings, hopped[0] if at_floor else best,
@@ -307,7 +308,7 @@ def identify(recording: Recording, *, spec: ChainSpec | None = None,
                              on_run=on_global_run)
     if improved and improved[-1].fun < min(h.fun for h in hopped + [best]):
         again, more = hop_with_cost(spec, rec, improved[-1], settings, floor, HOP_RUN_ID - 1,
-                                    on_jump=on_jump)
+                                    on_jump=on_jump, n_workers=n_workers)
         hopped += [again] if again is not None else []
         spent += more
     ident = summarise(rec, spec, settings, runs + hopped + improved)

@@ -25,8 +25,13 @@ cent of the box from it, each polished, cross those edges: on #163 the floor
 is reached after 14 jumps, about a second.
 
 Monotonic basin hopping (a jump is kept only when its polish does better),
-with its own random stream drawn from the seed; it runs in the calling
-process, so the answer does not depend on the number of workers.
+with its own random stream drawn from the seed. With more than one worker the
+next jumps are polished side by side in forked processes, speculatively: each
+starts from the fit as it stands, and when one of them improves the fit, the
+jumps after it, which started from the old fit, are dropped and made again
+from the new one. Jumps are taken and judged in their order, with the same
+random steps, so the answer does not depend on the number of workers; the
+time does, as far as jumps fail (most do).
 """
 
 from __future__ import annotations
@@ -35,11 +40,13 @@ from dataclasses import replace
 from typing import Callable
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from hyst_id.identification.chains import ChainSpec, er_percent
 from hyst_id.identification.global_phase import run_from_fit
 from hyst_id.identification.refine import refine
 from hyst_id.identification.result import IdentifySettings, SeedRun
+from hyst_id.identification.workers import forked_pool
 from hyst_id.io.recording import Recording
 
 __all__ = ['hop', 'hop_with_cost', 'HOP_FULL_SAMPLES', 'HOP_MIN', 'HOP_NFEV', 'HOP_RUN_ID',
@@ -71,8 +78,8 @@ def hop(spec: ChainSpec, rec: Recording, best: SeedRun, settings: IdentifySettin
 
 def hop_with_cost(spec: ChainSpec, rec: Recording, best: SeedRun, settings: IdentifySettings,
                   floor_percent: float, run_id: int = HOP_RUN_ID,
-                  on_jump: Callable[[int, int, float], None] | None = None
-                  ) -> tuple[SeedRun | None, int]:
+                  on_jump: Callable[[int, int, float], None] | None = None,
+                  n_workers: int = 1) -> tuple[SeedRun | None, int]:
     """Basin hopping from ``best``: the improved run (or ``None``) and the evaluations spent.
 
     Parameters
@@ -98,6 +105,9 @@ def hop_with_cost(spec: ChainSpec, rec: Recording, best: SeedRun, settings: Iden
         Called as ``on_jump(done, jumps, er_percent)`` before each jump
         (``done`` jumps made so far, the best %e_r so far) and once at the end
         with ``done == jumps``, for progress displays; it may raise to stop.
+    n_workers : int
+        Processes polishing jumps side by side (see the module's docstring);
+        1, or no safe fork, polishes them one after the other here.
 
     Returns
     -------
@@ -115,22 +125,32 @@ def hop_with_cost(spec: ChainSpec, rec: Recording, best: SeedRun, settings: Iden
     lo, hi = spec.bounds[:, 0], spec.bounds[:, 1]
     rng = np.random.default_rng([settings.seeds[0], 11, -run_id])
     x, fun = np.asarray(best.x_raw, dtype=float), float(best.fun)
-    nfev, improved = 0, False
     # a jump's polish costs in proportion to the samples: fewer jumps on a long record
     jumps = min(settings.hops, max(HOP_MIN, int(settings.hops * min(
         1.0, HOP_FULL_SAMPLES / rec.n_samples))))
-    for done in range(jumps):
-        if er_percent(fun, y) <= settings.global_factor * floor_percent:
-            break
-        if on_jump is not None:
-            on_jump(done, jumps, float(er_percent(fun, y)))
-        jump = np.clip(x + rng.normal(0.0, HOP_SCALE, x.size) * (hi - lo), lo, hi)
-        if not spec.feasible(jump[None, :])[0]:
-            continue
-        x_new, f_new, n = refine(spec, jump, t_s, v, y, max_nfev=HOP_NFEV)
-        nfev += n
-        if f_new < fun * (1.0 - 1e-9):
-            x, fun, improved = x_new, f_new, True
+    steps = rng.normal(0.0, HOP_SCALE, (jumps, x.size))    # one row per jump, in order
+    nfev, improved, done = 0, False, 0
+    with threadpool_limits(limits=1), forked_pool(n_workers) as pool:
+        while done < jumps and er_percent(fun, y) > settings.global_factor * floor_percent:
+            batch = range(done, min(jumps, done + (1 if pool is None else n_workers)))
+            starts = {k: np.clip(x + steps[k] * (hi - lo), lo, hi) for k in batch}
+            starts = {k: s for k, s in starts.items() if spec.feasible(s[None, :])[0]}
+            polished = ({k: pool.submit(_polish, spec, s, t_s, v, y) for k, s in starts.items()}
+                        if pool is not None else {})
+            for k in batch:
+                if er_percent(fun, y) <= settings.global_factor * floor_percent:
+                    break
+                if on_jump is not None:
+                    on_jump(k, jumps, float(er_percent(fun, y)))
+                done = k + 1
+                if k not in starts:
+                    continue
+                x_new, f_new, n = (polished[k].result() if pool is not None
+                                   else _polish(spec, starts[k], t_s, v, y))
+                nfev += n
+                if f_new < fun * (1.0 - 1e-9):
+                    x, fun, improved = x_new, f_new, True
+                    break       # the batch's later jumps started from the old fit
     if on_jump is not None:
         on_jump(jumps, jumps, float(er_percent(fun, y)))       # the end of hopping
     if not improved:
@@ -138,3 +158,9 @@ def hop_with_cost(spec: ChainSpec, rec: Recording, best: SeedRun, settings: Iden
     run = run_from_fit(spec, rec, x, fun, run_id=run_id, nfev=nfev, nit=0,
                        message='basin hopping from the best run')
     return (run if np.isfinite(run.fun) else None), nfev
+
+
+def _polish(spec: ChainSpec, start: np.ndarray, t_s: np.ndarray, v: np.ndarray,
+            y: np.ndarray) -> tuple[np.ndarray, float, int]:
+    """One jump's polish (module level: what a worker process runs)."""
+    return refine(spec, start, t_s, v, y, max_nfev=HOP_NFEV)

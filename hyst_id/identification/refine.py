@@ -23,10 +23,16 @@ Candidates that violate the loop constraints get a large constant residual,
 so the trust region shrinks back into the feasible set. The chain is
 piecewise linear in the command, so the residual is piecewise smooth in the
 parameters: the polish is restarted once from its own end point, which gets
-it past kinks where a first run stalls.
+it past kinks where a first run stalls. The points of one finite-difference
+Jacobian are evaluated together (H's kernel run once over them, through
+``least_squares``'s ``workers``), with the very numbers one at a time would
+give: only the Python calls per point go.
 """
 
 from __future__ import annotations
+
+import inspect
+from typing import Callable, Iterable
 
 import numpy as np
 from scipy.optimize import least_squares
@@ -34,6 +40,8 @@ from scipy.optimize import least_squares
 from hyst_id.identification.chains import ChainSpec
 
 __all__ = ['refine']
+
+_TAKES_WORKERS = 'workers' in inspect.signature(least_squares).parameters
 
 
 def refine(spec: ChainSpec, x0: np.ndarray, t_s: np.ndarray, command: np.ndarray,
@@ -67,6 +75,7 @@ def refine(spec: ChainSpec, x0: np.ndarray, t_s: np.ndarray, command: np.ndarray
     cost = spec.cost_function(t_s, command, y)
     lo, hi = spec.bounds[:, 0], spec.bounds[:, 1]
     penalty = np.full(y.shape[0], np.sqrt(np.sum(y ** 2) / y.shape[0]) * 10.0)
+    feasible_residual = spec.residual_function(t_s, command, y)
     nfev = 0
 
     def residual(x: np.ndarray) -> np.ndarray:
@@ -74,8 +83,18 @@ def refine(spec: ChainSpec, x0: np.ndarray, t_s: np.ndarray, command: np.ndarray
         nfev += 1
         if not spec.feasible(x[None, :])[0]:
             return penalty
-        return spec.residual(x, t_s, command, y)
+        return feasible_residual(x)
 
+    def jacobian_columns(_fun: Callable, steps: Iterable[np.ndarray]) -> list[np.ndarray]:
+        """The finite differences' evaluations, H run once for all (scipy's ``workers``)."""
+        nonlocal nfev
+        pop = np.array(list(steps), dtype=np.float64)
+        nfev += pop.shape[0]
+        ok = spec.feasible(pop)
+        return [penalty if r is None else r for r in feasible_residual.rows(pop, ok)]
+
+    # scipy >= 1.16 hands the finite differences' points to a map-like ``workers`` at once
+    batched = {'workers': jacobian_columns} if _TAKES_WORKERS else {}
     x_best = np.clip(np.asarray(x0, dtype=np.float64), lo, hi)
     f_best = float(cost(x_best[None, :])[0])
     for _ in range(1 + max(0, restarts)):
@@ -84,7 +103,7 @@ def refine(spec: ChainSpec, x0: np.ndarray, t_s: np.ndarray, command: np.ndarray
             break
         try:
             sol = least_squares(residual, x_best, bounds=(lo, hi), method='trf',
-                                x_scale='jac', max_nfev=budget)
+                                x_scale='jac', max_nfev=budget, **batched)
         except (ValueError, np.linalg.LinAlgError):
             break
         f_new = float(cost(sol.x[None, :])[0])

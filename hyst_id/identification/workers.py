@@ -45,7 +45,7 @@ from threadpoolctl import threadpool_limits
 
 from hyst_id.errors import IdentificationError
 
-__all__ = ['POLL_S', 'WorkersStopped', 'map_in_processes', 'mp_context']
+__all__ = ['POLL_S', 'WorkersStopped', 'forked_pool', 'map_in_processes', 'mp_context']
 
 #: How often a stop request is looked at while workers run [s].
 POLL_S = 0.2
@@ -179,3 +179,31 @@ def map_in_processes(fn: Callable[..., Any], arg_tuples: Sequence[tuple], n_work
             raise
         pool.shutdown(wait=True)
         return results
+
+
+@contextmanager
+def forked_pool(n_workers: int) -> Iterator[ProcessPoolExecutor | None]:
+    """A pool of ``n_workers`` forked processes for a loop that submits as it goes.
+
+    Yields ``None`` when a pool would not pay: one worker, or no safe fork
+    (threads running: spawning would cost seconds of imports per pool). On
+    leaving, queued tasks are dropped; on an error (also Ctrl-C or a stop
+    request raised by the loop) the workers are ended at once. Submitted
+    functions run with one BLAS thread, as the seeds' do.
+    """
+    ctx = mp_context()
+    if n_workers < 2 or ctx.get_start_method() != 'fork':
+        yield None
+        return
+    with threadpool_limits(limits=1):
+        pool = ProcessPoolExecutor(max_workers=n_workers, mp_context=ctx,
+                                   initializer=_worker_init, initargs=(os.getpid(),))
+        try:
+            yield pool
+        except BrokenProcessPool as exc:
+            _end(pool)
+            raise IdentificationError(f'a worker process died: {exc}') from None
+        except BaseException:
+            _end(pool)
+            raise
+        pool.shutdown(wait=True, cancel_futures=True)

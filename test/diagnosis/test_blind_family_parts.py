@@ -92,11 +92,12 @@ def test_a_run_in_parts_goes_on_from_rows_of_the_same_code_only(tmp_path):
 
 
 def test_the_time_line_compares_the_same_recordings_only():
-    """Medians over the recordings both runs hold (or the indices asked for), and their ratio."""
+    """Median, sum and max over the recordings both runs hold (or the indices asked for)."""
     old = [{'index': i, 'seconds': s} for i, s in enumerate([10.0, 20.0, 30.0])]
     new = [{'index': i, 'seconds': s} for i, s in [(1, 40.0), (2, 60.0), (3, 999.0)]]
     assert blind_family.time_ratio(old, new) == (
-        'seconds per recording on the same 2 recordings, median: 25 -> 50 (2.0 x)')
+        'seconds per recording on the same 2 recordings, median: 25 -> 50 (2.0 x); '
+        'sum 50 -> 100; max 30 -> 60')
     assert '1 recordings, median: 30 -> 60' in blind_family.time_ratio(old, new, [2])
     assert blind_family.time_ratio(old, new, [7]) == 'no recording in both runs'
 

@@ -150,3 +150,40 @@ def test_on_jump_is_called_before_each_jump(trap):
                   on_jump=lambda *a: calls.append(a))
     assert [c[:2] for c in calls] == [(k, 4) for k in range(4)] + [(4, 4)]   # 4 jumps, end
     assert all(c[2] <= run.er_percent * (1 + 1e-12) for c in calls)
+
+
+@pytest.mark.parametrize('hops, floor_div', [(100, 1.0), (12, 3.9)])
+def test_jumps_polished_side_by_side_give_the_same_answer(trap, hops, floor_div):
+    """Two workers polish jumps speculatively; the run, its cost and the calls are the same.
+
+    The trap improves on several jumps (so speculative jumps are dropped and made again);
+    a floor it cannot reach makes every jump.
+    """
+    rec, spec, run, floor = trap
+    floor = floor if floor_div == 1.0 else run.er_percent / floor_div
+    settings = IdentifySettings(hops=hops)
+    outs = []
+    for workers in (1, 2):
+        calls = []
+        out, nfev = hop_with_cost(spec, rec, run, settings, floor, n_workers=workers,
+                                  on_jump=lambda *a, c=calls: c.append(a))
+        outs.append((out, nfev, calls))
+    (a, nfev_a, calls_a), (b, nfev_b, calls_b) = outs
+    assert nfev_a == nfev_b and calls_a == calls_b
+    assert (a is None) == (b is None)
+    if a is not None:
+        np.testing.assert_array_equal(a.x_raw, b.x_raw)
+        assert a.fun == b.fun
+
+
+def test_a_stop_while_jumps_are_polished_side_by_side_ends_the_workers(trap):
+    from hyst_id.identification.workers import WorkersStopped
+    rec, spec, run, _ = trap
+
+    def stop(done, jumps, er):
+        if done == 3:
+            raise WorkersStopped('stopped on request while hopping')
+
+    with pytest.raises(WorkersStopped):
+        hop_with_cost(spec, rec, run, IdentifySettings(hops=10), run.er_percent / 3.9,
+                      on_jump=stop, n_workers=2)
