@@ -474,7 +474,13 @@ def main() -> int:
     ap.add_argument('--compare', metavar='OLD_JSON',
                     help='only list the recordings whose findings or final (by more than '
                          '0.05 x) differ between OLD_JSON and docs/diagnosis_blind.json '
-                         '(or the rows of a run in parts on this code, while there are any)')
+                         '(or the rows of a run in parts on this code, while there are any; '
+                         'or --against), and their times')
+    ap.add_argument('--rows-out', metavar='JSON',
+                    help='with --indices: also write the rows of this run to JSON (for '
+                         '--compare ... --against JSON: two runs of the same recordings)')
+    ap.add_argument('--against', metavar='NEW_JSON',
+                    help='with --compare: compare with NEW_JSON instead of the documented run')
     ap.add_argument('--from-json', action='store_true',
                     help='only reprint the tables from docs/diagnosis_blind.json')
     ap.add_argument('--so-far', action='store_true',
@@ -495,8 +501,11 @@ def main() -> int:
     if args.csv:
         return write_csv(Path(args.csv), args.indices or list(range(args.n)))
     if args.compare:
-        now = rows_so_far()
-        if now:
+        now = [] if args.against else rows_so_far()
+        if args.against:
+            print(f'comparing with {args.against}')
+            now = json.loads(Path(args.against).read_text())
+        elif now:
             print(f'comparing the {len(now)} rows of the run in parts on this code '
                   f'({PARTIAL.name})')
         else:
@@ -535,6 +544,9 @@ def main() -> int:
         return 0
     text = summary(rows, how)
     print(text)
+    if args.indices and args.rows_out:
+        Path(args.rows_out).write_text(json.dumps(
+            [{key: v for key, v in r.items() if key != 'code'} for r in rows], indent=1))
     if args.indices:      # against the documented run, on the same recordings
         documented = json.loads((ROOT / 'docs' / 'diagnosis_blind.json').read_text())
         print('against docs/diagnosis_blind.json:\n' + moved(documented, rows) + '\n'
