@@ -132,7 +132,10 @@ def hop_with_cost(spec: ChainSpec, rec: Recording, best: SeedRun, settings: Iden
     nfev, improved, done = 0, False, 0
     with threadpool_limits(limits=1), forked_pool(n_workers) as pool:
         while done < jumps and er_percent(fun, y) > settings.global_factor * floor_percent:
-            batch = range(done, min(jumps, done + (1 if pool is None else n_workers)))
+            # with workers every jump left is queued: polishes differ widely in length
+            # (on blind #84 five of 100 took half the time), and a full queue keeps
+            # every worker busy past a long one
+            batch = range(done, done + 1 if pool is None else jumps)
             starts = {k: np.clip(x + steps[k] * (hi - lo), lo, hi) for k in batch}
             starts = {k: s for k, s in starts.items() if spec.feasible(s[None, :])[0]}
             polished = ({k: pool.submit(_polish, spec, s, t_s, v, y) for k, s in starts.items()}
@@ -151,6 +154,8 @@ def hop_with_cost(spec: ChainSpec, rec: Recording, best: SeedRun, settings: Iden
                 if f_new < fun * (1.0 - 1e-9):
                     x, fun, improved = x_new, f_new, True
                     break       # the batch's later jumps started from the old fit
+            for later in polished.values():
+                later.cancel()  # the queued ones; a running one ends unread
     if on_jump is not None:
         on_jump(jumps, jumps, float(er_percent(fun, y)))       # the end of hopping
     if not improved:
