@@ -156,7 +156,7 @@ def map_in_processes(fn: Callable[..., Any], arg_tuples: Sequence[tuple], n_work
     with threadpool_limits(limits=1), _sigint_deferred() as interrupted:
         pool = ProcessPoolExecutor(max_workers=n_workers, mp_context=mp_context(),
                                    initializer=_worker_init, initargs=(os.getpid(),))
-        try:
+        with _ended_on_error(pool):
             futures: list[Future] = [pool.submit(fn, *args) for args in arg_tuples]
             pending = set(futures)
             while pending:
@@ -171,14 +171,21 @@ def map_in_processes(fn: Callable[..., Any], arg_tuples: Sequence[tuple], n_work
             if interrupted():
                 raise KeyboardInterrupt
             results = [f.result() for f in futures]
-        except BrokenProcessPool as exc:
-            _end(pool)
-            raise IdentificationError(f'a worker process died: {exc}') from None
-        except BaseException:
-            _end(pool)
-            raise
         pool.shutdown(wait=True)
         return results
+
+
+@contextmanager
+def _ended_on_error(pool: ProcessPoolExecutor) -> Iterator[ProcessPoolExecutor]:
+    """End ``pool``'s workers at once when the block raises; a dead worker is reported."""
+    try:
+        yield pool
+    except BrokenProcessPool as exc:
+        _end(pool)
+        raise IdentificationError(f'a worker process died: {exc}') from None
+    except BaseException:
+        _end(pool)
+        raise
 
 
 @contextmanager
@@ -198,12 +205,6 @@ def forked_pool(n_workers: int) -> Iterator[ProcessPoolExecutor | None]:
     with threadpool_limits(limits=1):
         pool = ProcessPoolExecutor(max_workers=n_workers, mp_context=ctx,
                                    initializer=_worker_init, initargs=(os.getpid(),))
-        try:
+        with _ended_on_error(pool):
             yield pool
-        except BrokenProcessPool as exc:
-            _end(pool)
-            raise IdentificationError(f'a worker process died: {exc}') from None
-        except BaseException:
-            _end(pool)
-            raise
         pool.shutdown(wait=True, cancel_futures=True)
