@@ -114,6 +114,9 @@ def _progress_bar(args: argparse.Namespace, settings,
     if getattr(args, 'quiet', False):
         return None
     from tqdm import tqdm
+    # no monitor thread: with a thread running the worker pools could not fork
+    # (workers.mp_context) and would spawn, paying every import again
+    tqdm.monitor_interval = 0
     bar = tqdm(total=total or len(settings.seeds), desc='GAASS seeds', unit='seed',
                file=sys.stderr, leave=False)
 

@@ -65,3 +65,21 @@ def test_model_auto_counts_on_past_its_first_total(monkeypatch):
 
 def test_quiet_has_no_bar():
     assert _progress_bar(argparse.Namespace(quiet=True), IdentifySettings()) is None
+
+
+def test_the_bar_starts_no_thread_so_the_worker_pools_can_fork():
+    import argparse
+    import threading
+    from hyst_id.commands.identify import _progress_bar
+    from hyst_id.identification.result import IdentifySettings
+    from hyst_id.identification.workers import mp_context
+    before = threading.active_count()
+    progress = _progress_bar(argparse.Namespace(quiet=False), IdentifySettings())
+    try:
+        progress.bar.update(1)
+        progress.bar.refresh()
+        assert threading.active_count() == before
+        if before == 1 and 'fork' in __import__('multiprocessing').get_all_start_methods():
+            assert mp_context().get_start_method() == 'fork'
+    finally:
+        progress.bar.close()
