@@ -344,6 +344,12 @@ def time_ratio(old: list[dict], new: list[dict], indices: list[int] | None = Non
             f'max {slowest[0]:.0f} -> {slowest[1]:.0f}')
 
 
+def _rows_json(rows: list[dict]) -> str:
+    """The rows as written to a JSON file (without the code hash of the run in parts)."""
+    return json.dumps([{key: v for key, v in r.items() if key != 'code'} for r in rows],
+                      indent=1)
+
+
 def write_csv(folder: Path, indices: list[int]) -> int:
     """Write recordings as CSV with their truth beside them (nothing is diagnosed)."""
     folder.mkdir(parents=True, exist_ok=True)
@@ -501,11 +507,10 @@ def main() -> int:
     if args.csv:
         return write_csv(Path(args.csv), args.indices or list(range(args.n)))
     if args.compare:
-        now = [] if args.against else rows_so_far()
         if args.against:
             print(f'comparing with {args.against}')
             now = json.loads(Path(args.against).read_text())
-        elif now:
+        elif now := rows_so_far():
             print(f'comparing the {len(now)} rows of the run in parts on this code '
                   f'({PARTIAL.name})')
         else:
@@ -528,6 +533,12 @@ def main() -> int:
     if args.more_starts and not args.indices:
         print('--more-starts only with --indices (the documented run uses the defaults)')
         return 2
+    if args.against:
+        print('--against only with --compare')
+        return 2
+    if args.rows_out and not args.indices:
+        print('--rows-out only with --indices (a full run writes docs/diagnosis_blind.json)')
+        return 2
     indices = args.indices or list(range(args.n))
     k = args.diagnose_workers
     one = functools.partial(run, more_starts=args.more_starts)
@@ -544,16 +555,14 @@ def main() -> int:
         return 0
     text = summary(rows, how)
     print(text)
-    if args.indices and args.rows_out:
-        Path(args.rows_out).write_text(json.dumps(
-            [{key: v for key, v in r.items() if key != 'code'} for r in rows], indent=1))
+    if args.rows_out:
+        Path(args.rows_out).write_text(_rows_json(rows))
     if args.indices:      # against the documented run, on the same recordings
         documented = json.loads((ROOT / 'docs' / 'diagnosis_blind.json').read_text())
         print('against docs/diagnosis_blind.json:\n' + moved(documented, rows) + '\n'
               + time_ratio(documented, rows, args.indices))
     if full:
-        (ROOT / 'docs' / 'diagnosis_blind.json').write_text(json.dumps(
-            [{key: v for key, v in r.items() if key != 'code'} for r in rows], indent=1))
+        (ROOT / 'docs' / 'diagnosis_blind.json').write_text(_rows_json(rows))
         (ROOT / 'docs' / 'diagnosis_blind.md').write_text(
             '# Blind diagnosis on the reference family (issue 14)\n\nWritten by '
             f'`python bench/blind_family.py --n {args.n}'

@@ -47,7 +47,8 @@ from blind_family import draw  # noqa: E402, I100
 
 from hyst_id.identification.domains import domains_from_data  # noqa: E402
 from hyst_id.identification.driver import identify  # noqa: E402
-from hyst_id.identification.hop import _polish, HOP_SCALE, hop_with_cost  # noqa: E402
+from hyst_id.identification.hop import HOP_NFEV, HOP_SCALE, hop_with_cost  # noqa: E402
+from hyst_id.identification.refine import refine  # noqa: E402
 from hyst_id.identification.result import IdentifySettings  # noqa: E402
 from hyst_id.io.recording import Recording  # noqa: E402
 
@@ -77,7 +78,7 @@ def one(index: int) -> None:
         start = np.clip(best.x_raw + step * (hi - lo), lo, hi)
         if spec.feasible(start[None, :])[0]:
             t0 = time.perf_counter()
-            _polish(spec, start, rec.t_s, rec.command, rec.measurement)
+            refine(spec, start, rec.t_s, rec.command, rec.measurement, max_nfev=HOP_NFEV)
             lengths.append(time.perf_counter() - t0)
     lengths = np.sort(lengths)
     print(f'#{index}: 100 jumps, one worker {out[1][0]:.2f} s, two {out[2][0]:.2f} s '

@@ -274,11 +274,15 @@ class ChainSpec:
 
     def _signal(self, p: np.ndarray, v_h: np.ndarray, intervals: tuple[np.ndarray, bool],
                 n: int) -> np.ndarray:
-        u = self.family.simulate(p[:self.n_h], v_h, validate=False)
-        if self.falling:
-            u = np.ascontiguousarray(u[1:])
+        return self._tail(self.family.simulate(p[:self.n_h], v_h, validate=False), p, intervals,
+                          n)
+
+    def _tail(self, u: np.ndarray, p: np.ndarray, intervals: tuple[np.ndarray, bool],
+              n: int) -> np.ndarray:
+        """B and the sensor after H's output ``u`` (its extra first sample dropped if falling)."""
         out = np.empty(n)
-        tail_signal(u, np.ascontiguousarray(p[self.n_h:]), _KIND[self.channel], *intervals,
+        tail_signal(np.ascontiguousarray(u[1:] if self.falling else u),
+                    np.ascontiguousarray(p[self.n_h:]), _KIND[self.channel], *intervals,
                     self.falling, self.hold == 'after', out)
         return out
 
@@ -377,17 +381,9 @@ class ChainResiduals:
         u = np.empty((pop.shape[0], self.v_h.shape[0]))
         spec.family.simulate_rows(np.ascontiguousarray(pop[:, :spec.n_h]), self.v_h,
                                   np.ascontiguousarray(ok, dtype=np.bool_), u)
-        out: list[np.ndarray | None] = []
-        for i in range(pop.shape[0]):
-            if not ok[i]:
-                out.append(None)
-                continue
-            s = np.empty(self.v.shape[0])
-            tail_signal(np.ascontiguousarray(u[i, 1:] if spec.falling else u[i]),
-                        np.ascontiguousarray(pop[i, spec.n_h:]), _KIND[spec.channel],
-                        *self.intervals, spec.falling, spec.hold == 'after', s)
-            out.append(spec._minus_calibrated(s, self.y))
-        return out
+        n = self.v.shape[0]
+        return [spec._minus_calibrated(spec._tail(u[i], pop[i], self.intervals, n), self.y)
+                if ok[i] else None for i in range(pop.shape[0])]
 
 
 def _bounds_array(names: tuple[str, ...], bounds, base: np.ndarray | None,

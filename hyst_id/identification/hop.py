@@ -133,9 +133,9 @@ def hop_with_cost(spec: ChainSpec, rec: Recording, best: SeedRun, settings: Iden
     with threadpool_limits(limits=1), forked_pool(n_workers) as pool:
         while done < jumps and er_percent(fun, y) > settings.global_factor * floor_percent:
             # with workers every jump left is queued: polishes differ widely in length
-            # (on blind #84 five of 100 took half the time), and a full queue keeps
-            # every worker busy past a long one
-            batch = range(done, done + 1 if pool is None else jumps)
+            # (bench/hop_workers.py: on blind #84 the five longest of 100 take about half
+            # the time), and a full queue keeps every worker busy past a long one
+            batch = range(done, (done + 1) if pool is None else jumps)
             starts = {k: np.clip(x + steps[k] * (hi - lo), lo, hi) for k in batch}
             starts = {k: s for k, s in starts.items() if spec.feasible(s[None, :])[0]}
             polished = ({k: pool.submit(_polish, spec, s, t_s, v, y) for k, s in starts.items()}

@@ -16,6 +16,7 @@
 
 from __future__ import annotations
 
+from contextlib import contextmanager
 from dataclasses import replace
 from pathlib import Path
 import sys
@@ -153,15 +154,28 @@ def test_on_jump_is_called_before_each_jump(trap):
 
 
 @pytest.mark.parametrize('hops, floor_div', [(100, 1.0), (12, 3.9)])
-def test_jumps_polished_side_by_side_give_the_same_answer(trap, hops, floor_div):
+def test_jumps_polished_side_by_side_give_the_same_answer(trap, hops, floor_div,
+                                                          monkeypatch):
     """Two workers polish jumps speculatively; the run, its cost and the calls are the same.
 
     The trap improves on several jumps (so speculative jumps are dropped and made again);
     a floor it cannot reach makes every jump.
     """
+    import hyst_id.identification.hop as hop_module
+    from hyst_id.identification.workers import mp_context
     rec, spec, run, floor = trap
     floor = floor if floor_div == 1.0 else run.er_percent / floor_div
     settings = IdentifySettings(hops=hops)
+    pools = []
+    forked_pool = hop_module.forked_pool
+
+    @contextmanager
+    def seen_pool(n_workers):
+        with forked_pool(n_workers) as pool:
+            pools.append(pool)
+            yield pool
+
+    monkeypatch.setattr(hop_module, 'forked_pool', seen_pool)
     outs = []
     for workers in (1, 2):
         calls = []
@@ -169,6 +183,9 @@ def test_jumps_polished_side_by_side_give_the_same_answer(trap, hops, floor_div)
                                   on_jump=lambda *a, c=calls: c.append(a))
         outs.append((out, nfev, calls))
     (a, nfev_a, calls_a), (b, nfev_b, calls_b) = outs
+    assert pools[0] is None      # one worker: polished here, one after the other
+    if mp_context().get_start_method() == 'fork':
+        assert pools[1] is not None      # two: polished in the forked pool
     assert nfev_a == nfev_b and calls_a == calls_b
     assert (a is None) == (b is None)
     if a is not None:

@@ -21,7 +21,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from hyst_id.identification.chains import chain_spec, CHANNELS
+from hyst_id.identification.chains import chain_spec, ChainResiduals, CHANNELS
 from hyst_id.identification.refine import refine
 from hyst_id.models.registry import FAMILIES
 
@@ -52,8 +52,17 @@ def test_the_fast_residual_is_the_checked_one_bit_for_bit(channel, family, initi
             for uniform in (True, False):
                 t, v, y = _recording(rng, uniform)
                 fast = spec.residual_function(t, v, y)
-                for p in _feasible_draws(spec, rng):
-                    assert np.array_equal(fast(p), spec.residual(p, t, v, y))
+                pop = _feasible_draws(spec, rng)
+                checked = [spec.residual(p, t, v, y) for p in pop]
+                for p, r in zip(pop, checked):
+                    assert np.array_equal(fast(p), r)
+                # many sets with H run once; a row marked infeasible gives None
+                ok = np.ones(pop.shape[0], dtype=bool)
+                ok[1] = False
+                together = fast.rows(pop, ok)
+                assert together[1] is None
+                for i in (0, *range(2, pop.shape[0])):
+                    assert np.array_equal(together[i], checked[i])
 
 
 def test_refine_still_lowers_the_cost_from_a_feasible_start():
@@ -81,8 +90,15 @@ def test_refine_gives_the_same_bits_with_its_jacobian_points_evaluated_together(
     t, v, _ = _recording(rng, False)
     truth, start = _feasible_draws(spec, rng, 2)
     y = spec.simulate(truth, t, v, (1.0, 0.0)) + rng.normal(0.0, 0.01, t.size)
+    batches = []
+    rows = ChainResiduals.rows
+    monkeypatch.setattr(ChainResiduals, 'rows',
+                        lambda self, pop, ok: batches.append(len(pop)) or rows(self, pop, ok))
     together = refine(spec, start, t, v, y, max_nfev=800)
+    assert batches and max(batches) == spec.n_params    # a Jacobian's points at once
     monkeypatch.setattr(refine_module, '_TAKES_WORKERS', False)
+    n_batches = len(batches)
     alone = refine(spec, start, t, v, y, max_nfev=800)
+    assert len(batches) == n_batches                    # point by point
     np.testing.assert_array_equal(together[0], alone[0])
     assert together[1:] == alone[1:] and together[2] > 20
