@@ -24,7 +24,7 @@ from hyst_id.identification.chains import CHAIN_NAMES, ChainSpec
 from hyst_id.io.recording import Recording
 
 __all__ = ['add_output_arguments', 'add_recording_arguments', 'add_settings_arguments',
-           'load_recording', 'make_spec', 'make_settings']
+           'load_recording', 'make_spec', 'make_settings', 'progress_bar']
 
 
 def add_recording_arguments(parser: argparse.ArgumentParser) -> None:
@@ -126,3 +126,27 @@ def make_settings(args: argparse.Namespace) -> IdentifySettings:
 def make_spec(args: argparse.Namespace, rec: Recording, family: str | None = None) -> ChainSpec:
     """Chain spec with the search domains asked for (``--domains``) and H's ``family``."""
     return config.make_spec(rec, args.domains, family=family)
+
+
+def progress_bar(**kwargs):
+    """A tqdm bar on stderr that starts no monitor thread.
+
+    tqdm's monitor thread would make the worker pools spawn instead of fork
+    (:func:`hyst_id.identification.workers.mp_context` forks only while the
+    process runs one thread), paying every import again in each worker, and
+    basin hopping would run in one process. Every command's bar comes from here.
+
+    Parameters
+    ----------
+    **kwargs
+        Passed to ``tqdm`` (``total``, ``desc``, ``unit``, ...).
+
+    Returns
+    -------
+    tqdm.tqdm
+    """
+    import sys
+
+    from tqdm import tqdm
+    tqdm.monitor_interval = 0
+    return tqdm(file=sys.stderr, **kwargs)

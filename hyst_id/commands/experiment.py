@@ -30,6 +30,7 @@ from pathlib import Path
 import shutil
 import sys
 
+from hyst_id.commands.common import progress_bar
 from hyst_id.diagnosis import DiagnoseSettings
 from hyst_id.errors import ConfigError
 from hyst_id.identification import IdentifySettings
@@ -123,8 +124,7 @@ def run(args: argparse.Namespace) -> int:
           f'{n_seeds} seeds', file=sys.stderr)
     bar = None
     if not args.quiet:
-        from tqdm import tqdm
-        bar = tqdm(desc='GAASS seeds', unit='seed', file=sys.stderr, dynamic_ncols=True)
+        bar = progress_bar(desc='GAASS seeds', unit='seed', dynamic_ncols=True)
 
     def progress(advance: int, total: int, message: str) -> None:
         if bar is not None:

@@ -22,6 +22,7 @@ from pathlib import Path
 import re
 import sys
 
+from hyst_id.commands.common import progress_bar
 from hyst_id.errors import ConfigError
 from hyst_id.fleet import find_recordings, FleetOptions, loop_trends, run_fleet, write_table
 from hyst_id.fleet.table import fleet_rows
@@ -85,8 +86,7 @@ def run(args: argparse.Namespace) -> int:
                            diagnose=args.diagnose, topics=topics)
     bar = None
     if not args.no_progress:
-        from tqdm import tqdm
-        bar = tqdm(total=len(recordings), unit='rec', file=sys.stderr, desc='fleet')
+        bar = progress_bar(total=len(recordings), unit='rec', desc='fleet')
 
     def progress(done: int, total: int, doc: dict) -> None:
         if bar is not None:

@@ -26,6 +26,7 @@ from hyst_id.commands.common import (
     load_recording,
     make_settings,
     make_spec,
+    progress_bar,
 )
 from hyst_id.identification import identify
 
@@ -113,12 +114,8 @@ def _progress_bar(args: argparse.Namespace, settings,
                   total: int | None = None):
     if getattr(args, 'quiet', False):
         return None
-    from tqdm import tqdm
-    # no monitor thread: with a thread running the worker pools could not fork
-    # (workers.mp_context) and would spawn, paying every import again
-    tqdm.monitor_interval = 0
-    bar = tqdm(total=total or len(settings.seeds), desc='GAASS seeds', unit='seed',
-               file=sys.stderr, leave=False)
+    bar = progress_bar(total=total or len(settings.seeds), desc='GAASS seeds', unit='seed',
+                       leave=False)
 
     def progress(done: int, total: int, run) -> None:
         if run.seed < 0:                # a global run: its most runs grow the total
@@ -136,5 +133,5 @@ def _progress_bar(args: argparse.Namespace, settings,
     progress.close = bar.close          # the caller's, after identify: hopping and the
     #                                     global phase follow the seeds, and may end early
     progress.hopping = hopping          # basin hopping between the seeds and the global phase
-    progress.bar = bar                  # the tqdm bar itself (tests)
+    progress.bar = bar                  # the bar itself (tests)
     return progress

@@ -83,3 +83,24 @@ def test_the_bar_starts_no_thread_so_the_worker_pools_can_fork():
             assert mp_context().get_start_method() == 'fork'
     finally:
         progress.bar.close()
+
+
+def test_every_command_bar_comes_from_the_one_that_starts_no_thread():
+    """The experiment and fleet commands spawned their pools while their bars' threads ran."""
+    import threading
+    from pathlib import Path
+
+    import hyst_id.commands as commands
+    from hyst_id.commands.common import progress_bar
+    before = threading.active_count()
+    bar = progress_bar(total=3, desc='x')
+    try:
+        bar.update(1)
+        bar.refresh()
+        assert threading.active_count() == before
+    finally:
+        bar.close()
+    folder = Path(commands.__file__).parent
+    own = [p.name for p in sorted(folder.glob('*.py'))
+           if p.name != 'common.py' and 'from tqdm' in p.read_text()]
+    assert own == [], f'these commands make their own tqdm bar: {own}'
