@@ -86,9 +86,11 @@ def undone_record(fit: FitResult, data, ctx) -> tuple[np.ndarray, np.ndarray, li
     terms = {lab: a[:, j] * fit.coef[j] for j, lab in enumerate(fit.labels)}
     v, y, done = data.v, data.y, []
     for m in reversed(model.mechanisms):
-        got = m.undo(model.theta(fit.p, m.id), data.t_s, v, y, terms, ctx)
+        theta = model.theta(fit.p, m.id)
+        got = m.undo(theta, data.t_s, v, y, terms, ctx)
         if got is not None and np.all(np.isfinite(got[0])) and np.all(np.isfinite(got[1])):
             v, y = got
+            terms = m.undo_terms(theta, data.t_s, terms, ctx)
             done.append(m.id)
     return v, y, done
 

@@ -77,6 +77,39 @@ def test_undo_leaves_what_the_chain_alone_explains(mech_id):
     assert sse <= 1e-16 * float(y_u @ y_u)
 
 
+@pytest.mark.parametrize('gain_id', ['gain_drift', 'supply_decay'])
+def test_a_gain_in_time_undone_before_friction_leaves_the_chain_alone(gain_id):
+    """The gain is divided out of friction's term too, and the fit's terms stay as they were."""
+    gain, friction = MECHANISMS[gain_id], MECHANISMS['friction']
+    t = np.arange(0.0, 60.0, 0.05)
+    v = _record(t)
+    ctx = Context('position', t, 840)
+    spec = chain_spec('position')
+    model = ComposedModel('position', [friction, gain], ctx, spec.bounds)
+    thetas = {m.id: m.starts(ctx)[0] for m in (friction, gain)}
+    p = model.pack(TRUTH, thetas)
+    a = model.evaluate(p, t, v, ctx.n_train).matrix()
+    coef = np.linspace(1.5, 0.5, a.shape[1])
+    coef[0] = 3.0
+    y = a @ coef
+    data = Data(t_s=t, v=v, y=y, n_train=ctx.n_train)
+    fit = evaluate(model, data, p)
+    before = model.evaluate(fit.p, t, v, ctx.n_train).matrix() * fit.coef
+    v_u, y_u, done = undone_record(fit, data, ctx)
+    assert sorted(done) == sorted([gain_id, 'friction'])
+    np.testing.assert_array_equal(
+        model.evaluate(fit.p, t, v, ctx.n_train).matrix() * fit.coef, before)
+    base = ComposedModel('position', [], ctx, spec.bounds)
+    a0 = base.evaluate(TRUTH, t, v_u, ctx.n_train).matrix()
+    _, sse = solve_linear(a0, y_u)
+    assert sse <= 1e-16 * float(y_u @ y_u)
+    terms = dict(zip(fit.labels, before.T))
+    kept = {k: c.copy() for k, c in terms.items()}
+    out = gain.undo_terms(model.theta(fit.p, gain_id), t, terms, ctx)
+    assert out is not terms and all(np.array_equal(terms[k], kept[k]) for k in kept)
+    assert not np.allclose(out['friction:0'], terms['friction:0'])
+
+
 def _drifting(seed: int):
     """Moves and holds read through a gain growing about a distant zero (the blind family's #42).
 

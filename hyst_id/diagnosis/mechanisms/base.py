@@ -278,6 +278,17 @@ class Mechanism:
             return v, (y - np.sum(own, axis=0)) if own else y
         return None
 
+    def undo_terms(self, theta: np.ndarray, t_s: np.ndarray, terms: dict[str, np.ndarray],
+                   ctx: Context) -> dict[str, np.ndarray]:
+        """The fitted terms as the record with this block undone holds them.
+
+        Called after :meth:`undo` succeeded, before the next block is undone;
+        returns a new mapping (``terms`` is not changed). By default the
+        terms are unchanged; a block that scales the others (a gain in time)
+        returns them with its scaling taken out.
+        """
+        return terms
+
     # -- words -------------------------------------------------------------
     def describe(self, theta: np.ndarray, coef: np.ndarray, info: dict,
                  ctx: Context) -> dict[str, Quantity]:

@@ -92,20 +92,22 @@ class TimeGain(Mechanism):
         return [c * g for c in columns[:-1]] + [g, columns[-1]]
 
     def undo(self, theta, t_s, v, y, terms, ctx) -> tuple[np.ndarray, np.ndarray] | None:
-        """The gain divided out about the reading it leaves unchanged (the constant ``b1``).
-
-        The other blocks' fitted terms in ``terms`` carry the gain too; they are
-        divided by it here (in place), so that a block undone after this one
-        (an additive term of the quantity, as friction's) takes out what is left
-        of it in the gain-free record.
-        """
+        """The gain divided out about the reading it leaves unchanged (the constant ``b1``)."""
         g = self.gain(float(theta[0]), t_s - ctx.t_s[0])
         if not np.all(g > 1e-3):
             return None     # a gain through zero cannot be divided out
         b1 = float(terms['offset'][0])
-        for k in [k for k in terms if k != 'offset']:
-            terms[k] = terms[k] / g
         return v, (y - b1) / g + b1
+
+    def undo_terms(self, theta, t_s, terms, ctx) -> dict[str, np.ndarray]:
+        """The other blocks' fitted terms with the gain divided out of them too.
+
+        So that a block undone after this one (an additive term of the
+        quantity, as friction's) takes out what is left of it in the gain-free
+        record. The constant ``b1`` is not gained and stays.
+        """
+        g = self.gain(float(theta[0]), t_s - ctx.t_s[0])
+        return {k: c if k == 'offset' else c / g for k, c in terms.items()}
 
     def evidence(self, loc) -> tuple[float, dict]:
         """A time trend whose size scales with the output level."""
