@@ -163,14 +163,17 @@ def _unknown_lines(d: Any) -> list[str]:
                            sorted(train_only, key=lambda z: z[1]))
 
 
+def _withdrawn_clause(ids: list[str]) -> str:
+    """Why the rounds' claims ``ids`` were withdrawn: one wording for every verdict."""
+    return (f"{' and '.join(ids)} improved on the baseline (table below) but "
+            f"{'were' if len(ids) > 1 else 'was'} withdrawn: the chain alone, searched again "
+            'with more data-built starts, predicts the judged held-out part as well (note below)')
+
+
 def _withdrawn_lines(d: Any) -> list[str]:
     """A sentence under the verdict when the challenge withdrew the rounds' claims."""
     ids = d.extra.get('withdrawn') or []
-    if not ids:
-        return []
-    return [f"  - {' and '.join(ids)} improved on the baseline (table below) and was withdrawn: "
-            'the chain alone, searched again with more data-built starts, predicts the judged '
-            'held-out part as well (note below)']
+    return [f'  - {_withdrawn_clause(ids)}'] if ids else []
 
 
 def format_diagnosis(d: Any) -> str:
@@ -217,11 +220,9 @@ def format_diagnosis(d: Any) -> str:
             lines += _withdrawn_lines(d)
         elif d.extra.get('withdrawn'):
             ratio = d.final.er_holdout_percent / d.noise_floor_percent
-            lines.append(f"verdict: none - {' and '.join(d.extra['withdrawn'])} improved on "
-                         'the baseline (table below), but the chain alone, searched again with '
-                         'more data-built starts, predicts the held-out part as well (note '
-                         f'below; {ratio:.2f} x the noise floor on held-out data): the baseline '
-                         'had stopped short of its basin, and no physics is missing.')
+            lines.append(f"verdict: none - {_withdrawn_clause(d.extra['withdrawn'])}; "
+                         f'{ratio:.2f} x the noise floor on held-out data: the baseline had '
+                         'stopped short of its basin, and no physics is missing.')
         else:
             ratio = d.final.er_holdout_percent / d.noise_floor_percent
             lines.append('verdict: none - no mechanism of the library improves the held-out '

@@ -136,6 +136,19 @@ def test_a_diagnosis_with_more_starts_is_not_challenged_again(monkeypatch):
     assert got is None and calls == []
 
 
+def test_the_withdrawal_reads_the_same_under_every_verdict():
+    from types import SimpleNamespace
+
+    from hyst_id.diagnosis.report import _withdrawn_clause, _withdrawn_lines
+    two = _withdrawn_clause(['creep', 'dead_time'])
+    assert two.startswith('creep and dead_time improved on the baseline (table below) but were '
+                          'withdrawn: '), two
+    d = SimpleNamespace(extra={'withdrawn': ['creep']})
+    assert _withdrawn_lines(d) == [f"  - {_withdrawn_clause(['creep'])}"]
+    assert 'but was withdrawn' in _withdrawn_lines(d)[0]
+    assert _withdrawn_lines(SimpleNamespace(extra={})) == []
+
+
 @pytest.mark.slow
 def test_a_diagnosis_whose_claims_fall_says_so(monkeypatch):
     """In the driver: no finding, verdict none, the withdrawn ids in the JSON and the report."""
@@ -157,7 +170,9 @@ def test_a_diagnosis_whose_claims_fall_says_so(monkeypatch):
     assert d.extra['withdrawn'] == ['dead_time']
     assert d.to_dict()['withdrawn'] == ['dead_time']
     text = d.report()
-    assert 'verdict: none - dead_time improved on the baseline' in text
+    assert ('verdict: none - dead_time improved on the baseline (table below) but was withdrawn: '
+            'the chain alone, searched again with more data-built starts, predicts the judged '
+            'held-out part as well (note below); ') in text, text
     assert 'dead_time accepted in the rounds and withdrawn at the end' in text
     assert 'final model: the same chain, from a wider search' in text
     assert 'accepted (chosen, withdrawn)' in text
