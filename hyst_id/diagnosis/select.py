@@ -167,9 +167,6 @@ class Comparison:
     #: a filter block's fit in the ``after`` hold that was dropped as a one-sample delay
     #: in disguise (:func:`hyst_id.diagnosis.trial.try_mechanism`), kept for the report
     screened: FitResult | None = None
-    #: a family swap's search carried from a worker process to the round's parent
-    #: (:func:`hyst_id.diagnosis.baseline.remember`); empty otherwise
-    memo: dict = field(default_factory=dict, compare=False, repr=False)
 
 
 def evaluate(model: ComposedModel, data: Data, p: np.ndarray, nfev: int = 0) -> FitResult:

@@ -80,7 +80,6 @@ def try_all(mechs: list[Mechanism], current: FitResult, data: Data, ctx: Context
         for m in mechs:
             say(f'testing {m.id}')
             comps.append(try_mechanism(m, current, data, ctx, settings, loc, chain_starts))
-            comps[-1].memo = {}    # already held in this process
         return comps
     say(f'testing {", ".join(m.id for m in mechs)} in {workers} processes')
     order = sorted(range(len(mechs)), key=lambda i: (
@@ -88,15 +87,30 @@ def try_all(mechs: list[Mechanism], current: FitResult, data: Data, ctx: Context
     # a worker does not start workers of its own; a stop check does not cross processes
     one = replace(settings, workers=1, should_stop=None)
     memo = quick_memo()     # the swaps' searches so far, for workers that did not fork them
-    got = map_in_processes(try_mechanism, [(mechs[i], current, data, ctx, one, loc, chain_starts,
-                                            memo) for i in order], workers,
-                           on_result=lambda c: say(f'{c.mechanism} fitted'))
+    got = map_in_processes(_try_in_worker, [(mechs[i], current, data, ctx, one, loc,
+                                             chain_starts, memo) for i in order], workers,
+                           on_result=lambda r: say(f'{r[0].mechanism} fitted'))
     comps: list[Comparison | None] = [None] * len(mechs)
-    for i, comp in zip(order, got):
+    for i, (comp, searched) in zip(order, got):
         comps[i] = comp
-        remember(comp.memo)   # a swap's search, for the next round
-        comp.memo = {}
+        remember(searched)    # a swap's search, for the next round
     return comps
+
+
+def _try_in_worker(m: Mechanism, current: FitResult, data: Data, ctx: Context,
+                   settings: DiagnoseSettings, loc: Localization,
+                   chain_starts: list[np.ndarray], memo: dict) -> tuple[Comparison, dict]:
+    """:func:`try_mechanism` in a worker process, and the family swap's search it made.
+
+    ``memo``: the swaps' searches the round's parent holds
+    (:func:`hyst_id.diagnosis.baseline.quick_memo`), for a worker that did not fork
+    them; the second value is this worker's searches when ``m`` swaps the family
+    (empty otherwise), for the parent to keep for the next round.
+    """
+    if memo:
+        remember(memo)
+    comp = try_mechanism(m, current, data, ctx, settings, loc, chain_starts)
+    return comp, (quick_memo() if getattr(m, 'swap_family', '') else {})
 
 
 def polish_all(pairs: list[tuple[ComposedModel, np.ndarray]], data: Data, max_nfev: int,
@@ -124,14 +138,12 @@ def _polish_one(model: ComposedModel, data: Data, x0: np.ndarray,
 
 def try_mechanism(m: Mechanism, current: FitResult, data: Data, ctx: Context,
                   settings: DiagnoseSettings, loc: Localization,
-                  chain_starts: list[np.ndarray], memo: dict | None = None) -> Comparison:
+                  chain_starts: list[np.ndarray]) -> Comparison:
     """Fit ``m`` into ``current`` and judge it (the criteria, its evidence, its plausibility).
 
-    ``memo``: family swaps' searches to reuse (:func:`hyst_id.diagnosis.baseline.quick_memo`
-    of the round's parent); a swap's own comes back in ``Comparison.memo``.
+    A family swap's search is kept in this process
+    (:func:`hyst_id.diagnosis.baseline.remember`) for the next round.
     """
-    if memo:
-        remember(memo)
     prev = current.model
     thetas = {pm.id: prev.theta(current.p, pm.id) for pm in prev.mechanisms}
     screened = None
@@ -156,8 +168,6 @@ def try_mechanism(m: Mechanism, current: FitResult, data: Data, ctx: Context,
                 fit = got
     comp = compare(current, fit, data, m.id, settings.criteria)
     comp.screened = screened
-    if getattr(m, 'swap_family', ''):
-        comp.memo = quick_memo()
     comp.evidence, comp.where = m.evidence(loc)
     model = fit.model
     theta = model.theta(fit.p, m.id) if m.id in model.slices else np.zeros(0)
