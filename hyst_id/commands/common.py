@@ -12,11 +12,12 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
-"""Arguments shared by the subcommands: reading a recording, GAASS settings, domains."""
+"""What the subcommands share: arguments (recording, GAASS settings, domains), the progress bar."""
 
 from __future__ import annotations
 
 import argparse
+from typing import Any
 
 from hyst_id.errors import ConfigError
 from hyst_id.identification import config, IdentifySettings
@@ -128,13 +129,14 @@ def make_spec(args: argparse.Namespace, rec: Recording, family: str | None = Non
     return config.make_spec(rec, args.domains, family=family)
 
 
-def progress_bar(**kwargs):
+def progress_bar(**kwargs) -> Any:
     """A tqdm bar on stderr that starts no monitor thread.
 
     tqdm's monitor thread would make the worker pools spawn instead of fork
     (:func:`hyst_id.identification.workers.mp_context` forks only while the
     process runs one thread), paying every import again in each worker, and
     basin hopping would run in one process. Every command's bar comes from here.
+    ``tqdm.monitor_interval`` stays 0 for the rest of the process.
 
     Parameters
     ----------

@@ -163,11 +163,15 @@ def _unknown_lines(d: Any) -> list[str]:
                            sorted(train_only, key=lambda z: z[1]))
 
 
-def _withdrawn_clause(ids: list[str]) -> str:
-    """Why the rounds' claims ``ids`` were withdrawn: one wording for every verdict."""
+def _withdrawn_clause(ids: list[str], detail: str = '') -> str:
+    """Why the rounds' claims ``ids`` were withdrawn: one wording for every verdict.
+
+    ``detail`` goes into the parenthesis after the pointer to the note.
+    """
     return (f"{' and '.join(ids)} improved on the baseline (table below) but "
             f"{'were' if len(ids) > 1 else 'was'} withdrawn: the chain alone, searched again "
-            'with more data-built starts, predicts the judged held-out part as well (note below)')
+            'with more data-built starts, predicts the judged held-out part as well (note '
+            f"below{'; ' + detail if detail else ''})")
 
 
 def _withdrawn_lines(d: Any) -> list[str]:
@@ -220,9 +224,10 @@ def format_diagnosis(d: Any) -> str:
             lines += _withdrawn_lines(d)
         elif d.extra.get('withdrawn'):
             ratio = d.final.er_holdout_percent / d.noise_floor_percent
-            lines.append(f"verdict: none - {_withdrawn_clause(d.extra['withdrawn'])}; "
-                         f'{ratio:.2f} x the noise floor on held-out data: the baseline had '
-                         'stopped short of its basin, and no physics is missing.')
+            detail = f'{ratio:.2f} x the noise floor on held-out data'
+            lines.append(f"verdict: none - {_withdrawn_clause(d.extra['withdrawn'], detail)}. "
+                         'The baseline had stopped short of its basin, and no physics is '
+                         'missing.')
         else:
             ratio = d.final.er_holdout_percent / d.noise_floor_percent
             lines.append('verdict: none - no mechanism of the library improves the held-out '

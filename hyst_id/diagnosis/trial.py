@@ -104,8 +104,8 @@ def _try_in_worker(m: Mechanism, current: FitResult, data: Data, ctx: Context,
 
     ``memo``: the swaps' searches the round's parent holds
     (:func:`hyst_id.diagnosis.baseline.quick_memo`), for a worker that did not fork
-    them; the second value is this worker's searches when ``m`` swaps the family
-    (empty otherwise), for the parent to keep for the next round.
+    them; the second value is every search the worker holds when ``m`` swaps the
+    family (empty otherwise), for the parent to keep for the next round.
     """
     if memo:
         remember(memo)

@@ -37,6 +37,7 @@ import time
 from typing import Any, Callable, Iterable
 
 from hyst_id.errors import ConfigError, HystIdError
+from hyst_id.identification.workers import mp_context
 
 __all__ = ['FleetOptions', 'find_recordings', 'fleet_task', 'result_path', 'run_fleet']
 
@@ -133,7 +134,9 @@ def fleet_task(path: str, options: FleetOptions) -> dict:
 
 def _executor(address: str | None, workers: int) -> tuple[Executor, Callable[[], None]]:
     if not address:
-        pool = ProcessPoolExecutor(max_workers=workers or os.cpu_count() or 1)
+        # fork where safe (no threads: the CLI's bar starts none), as identify's pools
+        pool = ProcessPoolExecutor(max_workers=workers or os.cpu_count() or 1,
+                                   mp_context=mp_context())
         return pool, lambda: pool.shutdown(wait=True, cancel_futures=True)
     try:
         from distributed import Client, LocalCluster

@@ -67,40 +67,57 @@ def test_quiet_has_no_bar():
     assert _progress_bar(argparse.Namespace(quiet=True), IdentifySettings()) is None
 
 
-def test_the_bar_starts_no_thread_so_the_worker_pools_can_fork():
+def _no_monitor_yet(monkeypatch):
+    """The defaults of tqdm, with no monitor thread left by an earlier bar of this process."""
+    import tqdm
+    if tqdm.tqdm.monitor is not None:
+        tqdm.tqdm.monitor.exit()
+    monkeypatch.setattr(tqdm.tqdm, 'monitor', None)
+    monkeypatch.setattr(tqdm.tqdm, 'monitor_interval', 10)
+
+
+def _monitors() -> list:
+    import threading
+    return [t for t in threading.enumerate() if t.name == 'tqdm_monitor' and t.is_alive()]
+
+
+def test_the_bar_starts_no_thread_so_the_worker_pools_can_fork(monkeypatch):
     import argparse
     import threading
+
     from hyst_id.commands.identify import _progress_bar
     from hyst_id.identification.result import IdentifySettings
     from hyst_id.identification.workers import mp_context
+    _no_monitor_yet(monkeypatch)
     before = threading.active_count()
     progress = _progress_bar(argparse.Namespace(quiet=False), IdentifySettings())
     try:
         progress.bar.update(1)
         progress.bar.refresh()
-        assert threading.active_count() == before
+        assert threading.active_count() == before and _monitors() == []
         if before == 1 and 'fork' in __import__('multiprocessing').get_all_start_methods():
             assert mp_context().get_start_method() == 'fork'
     finally:
         progress.bar.close()
 
 
-def test_every_command_bar_comes_from_the_one_that_starts_no_thread():
-    """The experiment and fleet commands spawned their pools while their bars' threads ran."""
+def test_every_command_bar_comes_from_the_one_that_starts_no_thread(monkeypatch):
+    """The experiment and fleet commands made bars whose monitor threads ran under the pools."""
     import threading
     from pathlib import Path
 
-    import hyst_id.commands as commands
+    import hyst_id
     from hyst_id.commands.common import progress_bar
+    _no_monitor_yet(monkeypatch)
     before = threading.active_count()
     bar = progress_bar(total=3, desc='x')
     try:
         bar.update(1)
         bar.refresh()
-        assert threading.active_count() == before
+        assert threading.active_count() == before and _monitors() == []
     finally:
         bar.close()
-    folder = Path(commands.__file__).parent
-    own = [p.name for p in sorted(folder.glob('*.py'))
-           if p.name != 'common.py' and 'from tqdm' in p.read_text()]
-    assert own == [], f'these commands make their own tqdm bar: {own}'
+    root = Path(hyst_id.__file__).parent
+    own = [str(p.relative_to(root)) for p in sorted(root.rglob('*.py'))
+           if p.name != 'common.py' and 'tqdm' in p.read_text(encoding='utf-8')]
+    assert own == [], f'these modules make their own tqdm bar: {own}'

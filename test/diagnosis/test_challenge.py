@@ -136,7 +136,7 @@ def test_a_diagnosis_with_more_starts_is_not_challenged_again(monkeypatch):
     assert got is None and calls == []
 
 
-def test_the_withdrawal_reads_the_same_under_every_verdict():
+def test_the_withdrawal_clause_says_was_or_were_and_takes_a_detail():
     from types import SimpleNamespace
 
     from hyst_id.diagnosis.report import _withdrawn_clause, _withdrawn_lines
@@ -147,6 +147,7 @@ def test_the_withdrawal_reads_the_same_under_every_verdict():
     assert _withdrawn_lines(d) == [f"  - {_withdrawn_clause(['creep'])}"]
     assert 'but was withdrawn' in _withdrawn_lines(d)[0]
     assert _withdrawn_lines(SimpleNamespace(extra={})) == []
+    assert _withdrawn_clause(['creep'], '1.02 x').endswith('(note below; 1.02 x)')
 
 
 @pytest.mark.slow
@@ -172,7 +173,7 @@ def test_a_diagnosis_whose_claims_fall_says_so(monkeypatch):
     text = d.report()
     assert ('verdict: none - dead_time improved on the baseline (table below) but was withdrawn: '
             'the chain alone, searched again with more data-built starts, predicts the judged '
-            'held-out part as well (note below); ') in text, text
+            'held-out part as well (note below; ') in text, text
     assert 'dead_time accepted in the rounds and withdrawn at the end' in text
     assert 'final model: the same chain, from a wider search' in text
     assert 'accepted (chosen, withdrawn)' in text

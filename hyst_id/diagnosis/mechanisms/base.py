@@ -284,10 +284,10 @@ class Mechanism:
 
         Called after :meth:`undo` succeeded, before the next block is undone;
         returns a new mapping (``terms`` is not changed). By default the
-        terms are unchanged; a block that scales the others (a gain in time)
+        terms are the same; a block that scales the others (a gain in time)
         returns them with its scaling taken out.
         """
-        return terms
+        return dict(terms)
 
     # -- words -------------------------------------------------------------
     def describe(self, theta: np.ndarray, coef: np.ndarray, info: dict,
