@@ -124,3 +124,17 @@ def test_fleet_on_a_local_dask_cluster(fleet_dir, tmp_path):
     status = {d['recording'].split('/')[-1]: d['status'] for d in docs}
     assert status == {'week0': 'ok', 'week1': 'ok', 'week2': 'ok', 'broken_bag': 'error',
                       'junk.mcap': 'error', 'flat.csv': 'error'}
+
+
+def test_the_local_pool_starts_its_workers_as_identify_does(monkeypatch):
+    """Fork where no other thread runs, spawn otherwise (workers.mp_context), not the default."""
+    import threading
+
+    from hyst_id.fleet import run as fleet_run
+    for threads, method in ((1, 'fork'), (3, 'spawn')):
+        monkeypatch.setattr(threading, 'active_count', lambda n=threads: n)
+        pool, close = fleet_run._executor(None, 1)
+        try:
+            assert pool._mp_context.get_start_method() == method
+        finally:
+            close()
