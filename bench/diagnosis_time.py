@@ -17,7 +17,9 @@
 Diagnoses blind-family recordings (``bench/blind_family.py``'s draw, the same
 recordings as its ``--indices``) in one process and prints, per recording, the
 total seconds, the seconds of each mechanism's trials summed over the rounds,
-friction's data-built starts, and how many of the family swap's quick searches
+friction's data-built starts, identify's data-built starts and conventions
+(its incumbent, :mod:`hyst_id.identification.incumbent`, in every
+identification of the diagnosis), and how many of the family swap's quick searches
 (:func:`hyst_id.diagnosis.baseline.quick_starts`) ran and what they cost. A
 search made once and reused in later rounds shows as one search in a
 diagnosis of several rounds. Times are wall seconds on this machine, with
@@ -47,6 +49,7 @@ from hyst_id.diagnosis import baseline, driver, refit, trial  # noqa: E402
 from hyst_id.diagnosis.driver import diagnose  # noqa: E402
 from hyst_id.diagnosis.mechanisms.friction import Friction  # noqa: E402
 from hyst_id.diagnosis.result import DiagnoseSettings  # noqa: E402
+from hyst_id.identification import driver as identify_driver  # noqa: E402
 from hyst_id.io.recording import Recording  # noqa: E402
 
 
@@ -77,6 +80,10 @@ def main() -> None:
         SEARCHES[0] if thorough else SEARCHES[1] if global_phase is None else SEARCHES[2]))
     for module in (baseline, driver, refit):        # each holds its own name for it
         module.baseline_starts = searches
+    incumbent_key = 'identify data-built starts (in the searches)'
+    for name in ('data_incumbent', 'rank_conventions'):     # identify's own name for each
+        setattr(identify_driver, name, timed(getattr(identify_driver, name),
+                                             lambda *a, **k: incumbent_key))
     Friction.data_starts = timed(Friction.data_starts,
                                  lambda *a, **k: 'friction data starts (in trial friction)')
     for i in args.indices:

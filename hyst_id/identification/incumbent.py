@@ -18,11 +18,19 @@ Before its seeds, :func:`hyst_id.identification.driver.identify` polishes the
 chains built from the data (:func:`data_incumbent`), ranks the initial states
 and sensor holds by them (:func:`rank_conventions`), and on a long record
 searches on a subset of the samples (:func:`search_subset`).
+
+The polishes of one step are independent of each other; with
+``settings.workers`` other than 1 they run in forked worker processes
+(:func:`hyst_id.identification.workers.forked_pool`; in this process when
+threads are running), each computed exactly as in one process and taken in
+the same order, so the answer does not depend on the number of workers.
 """
 
 from __future__ import annotations
 
+from concurrent.futures import ProcessPoolExecutor
 from dataclasses import replace
+import os
 
 import numpy as np
 from threadpoolctl import threadpool_limits
@@ -32,11 +40,12 @@ from hyst_id.identification.chains import ChainSpec, er_percent, HOLDS, INITIAL_
 from hyst_id.identification.refine import refine
 from hyst_id.identification.result import IdentifySettings
 from hyst_id.identification.starts import data_starts, MORE_SPLITS, SPLITS
+from hyst_id.identification.workers import forked_pool
 from hyst_id.io.recording import Recording
 from hyst_id.signals.reversals import reversal_indices
 
 __all__ = ['best_polished', 'choose_conventions', 'CONVENTION_GAIN', 'data_incumbent',
-           'rank_conventions', 'search_subset', 'SHORT_POLISH']
+           'polish_pool', 'rank_conventions', 'refined_each', 'search_subset', 'SHORT_POLISH']
 
 #: Another initial state or hold is taken only below this share of the current cost.
 CONVENTION_GAIN = 0.999
@@ -60,14 +69,33 @@ def data_incumbent(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray,
     :data:`~hyst_id.identification.starts.SPLITS` stays above it (or none of
     them is feasible), the starts
     of :data:`~hyst_id.identification.starts.MORE_SPLITS` are ranked and
-    polished the same way, and the better of the two is returned.
+    polished the same way, and the better of the two is returned. The polishes
+    run in a forked pool of ``settings.workers`` (:func:`polish_pool`).
     """
+    with polish_pool(settings) as pool:
+        return _data_incumbent(spec, t_s, command, measurement, settings, floor_percent, pool)
+
+
+def polish_pool(settings: IdentifySettings):
+    """A forked pool of ``settings.workers`` processes (0: one per core), or None in one.
+
+    A context manager (:func:`hyst_id.identification.workers.forked_pool`): None
+    with one worker or when threads are running.
+    """
+    return forked_pool(settings.workers or (os.cpu_count() or 1))
+
+
+def _data_incumbent(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray,
+                    measurement: np.ndarray, settings: IdentifySettings,
+                    floor_percent: float | None, pool: ProcessPoolExecutor | None
+                    ) -> tuple[np.ndarray, float, int] | None:
+    """:func:`data_incumbent` with its pool (None: this process)."""
     with threadpool_limits(limits=1):
-        best = _incumbent_of(spec, t_s, command, measurement, settings, SPLITS)
+        best = _incumbent_of(spec, t_s, command, measurement, settings, SPLITS, pool)
         if floor_percent is None or (best is not None
                                      and er_percent(best[1], measurement) <= floor_percent):
             return best
-        more = _incumbent_of(spec, t_s, command, measurement, settings, MORE_SPLITS)
+        more = _incumbent_of(spec, t_s, command, measurement, settings, MORE_SPLITS, pool)
     found = [r for r in (best, more) if r is not None]
     if not found:
         return None
@@ -76,7 +104,8 @@ def data_incumbent(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray,
 
 
 def _incumbent_of(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray,
-                  measurement: np.ndarray, settings: IdentifySettings, splits: tuple
+                  measurement: np.ndarray, settings: IdentifySettings, splits: tuple,
+                  pool: ProcessPoolExecutor | None = None
                   ) -> tuple[np.ndarray, float, int] | None:
     """:func:`data_incumbent` over the data-built starts of ``splits``."""
     try:
@@ -92,32 +121,48 @@ def _incumbent_of(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray,
     # the short polishes only rank the starts: a quarter of the subset on a long record
     few = search_subset(command, settings.search_samples // 4) if sub is not None else None
     ranking = search if few is None else (t_s[few], command[few], measurement[few])
-    for x0 in starts:
-        x, fun, k = refine(spec, x0, *ranking,
-                           max_nfev=SHORT_POLISH * (spec.n_params + 1), restarts=0)
+    for x, fun, k in refined_each(pool, [(spec, x0, *ranking) for x0 in starts],
+                                  max_nfev=SHORT_POLISH * (spec.n_params + 1), restarts=0):
         nfev += k
         short.append((fun, x))
     short.sort(key=lambda z: z[0])
     finalists = [x0 for _, x0 in short[:2]]
     if sub is not None:             # polish both on the subset, the better on all samples
-        x_sub, nfev_sub = best_polished(spec, finalists, search, settings.refine_max_nfev)
+        x_sub, nfev_sub = best_polished(spec, finalists, search, settings.refine_max_nfev,
+                                        pool=pool)
         finalists, nfev = [x_sub], nfev + nfev_sub
     best_x, best_fun = None, np.inf
-    for x0 in finalists:
-        x, fun, k = refine(spec, x0, t_s, command, measurement,
-                           max_nfev=settings.refine_max_nfev)
+    for x, fun, k in refined_each(pool, [(spec, x0, t_s, command, measurement)
+                                         for x0 in finalists],
+                                  max_nfev=settings.refine_max_nfev):
         nfev += k
         if fun < best_fun:
             best_x, best_fun = x, fun
     return (best_x, float(best_fun), nfev) if best_x is not None else None
 
 
-def best_polished(spec: ChainSpec, starts: list[np.ndarray], data: tuple, max_nfev: int
-                  ) -> tuple[np.ndarray, int]:
-    """The best of ``starts`` each refined on ``data`` (a search subset), and the evaluations."""
+def refined_each(pool: ProcessPoolExecutor | None, calls: list[tuple], **kwargs
+                 ) -> list[tuple[np.ndarray, float, int]]:
+    """``refine(*call, **kwargs)`` of each call, in order; in ``pool``'s workers when given.
+
+    Each polish is computed as in one process (one BLAS thread), so the list
+    is the same with or without a pool.
+    """
+    if pool is None or len(calls) < 2:
+        return [refine(*call, **kwargs) for call in calls]
+    futures = [pool.submit(refine, *call, **kwargs) for call in calls]
+    return [f.result() for f in futures]
+
+
+def best_polished(spec: ChainSpec, starts: list[np.ndarray], data: tuple, max_nfev: int, *,
+                  pool: ProcessPoolExecutor | None = None) -> tuple[np.ndarray, int]:
+    """The best of ``starts`` each refined on ``data`` (a search subset), and the evaluations.
+
+    ``pool``: worker processes to polish in (:func:`refined_each`).
+    """
     polished, nfev = [], 0
-    for x0 in starts:
-        x, fun, k = refine(spec, x0, *data, max_nfev=max_nfev)
+    for x, fun, k in refined_each(pool, [(spec, x0, *data) for x0 in starts],
+                                  max_nfev=max_nfev):
         nfev += k
         polished.append((fun, x))
     return min(polished, key=lambda z: z[0])[1], nfev
@@ -175,29 +220,28 @@ def rank_conventions(spec: ChainSpec, rec: Recording, incumbent: tuple[np.ndarra
     args = (rec.t_s, rec.command, rec.measurement)
     ranked = [(spec, incumbent)]
     nfev = incumbent[2]
-    with threadpool_limits(limits=1):
+    with threadpool_limits(limits=1), polish_pool(settings) as pool:
         for initial in INITIAL_STATES:
             if initial != spec.initial:
                 trial = replace(spec, initial=initial)
-                found = data_incumbent(trial, *args, settings, floor_percent)
+                found = _data_incumbent(trial, *args, settings, floor_percent, pool)
                 if found is None:
                     continue
                 nfev += found[2]
                 ranked.append((trial, (found[0], found[1], 0)))
-        for base, (x0, _, _) in list(ranked):
-            for hold in holds:
-                if hold == base.hold:
-                    continue
-                trial = replace(base, hold=hold)
-                x, fun, k = refine(trial, x0, *args, max_nfev=settings.refine_max_nfev)
-                nfev += k
-                if floor_percent is not None and er_percent(fun, rec.measurement) > floor_percent:
-                    found = data_incumbent(trial, *args, settings, floor_percent)
-                    if found is not None:
-                        nfev += found[2]
-                        if found[1] < fun:
-                            x, fun = found[0], found[1]
-                ranked.append((trial, (x, float(fun), 0)))
+        others = [(replace(base, hold=hold), x0) for base, (x0, _, _) in list(ranked)
+                  for hold in holds if hold != base.hold]
+        for (trial, _), (x, fun, k) in zip(others, refined_each(
+                pool, [(trial, x0, *args) for trial, x0 in others],
+                max_nfev=settings.refine_max_nfev)):
+            nfev += k
+            if floor_percent is not None and er_percent(fun, rec.measurement) > floor_percent:
+                found = _data_incumbent(trial, *args, settings, floor_percent, pool)
+                if found is not None:
+                    nfev += found[2]
+                    if found[1] < fun:
+                        x, fun = found[0], found[1]
+            ranked.append((trial, (x, float(fun), 0)))
     clearly = [e for e in ranked[1:] if e[1][1] < CONVENTION_GAIN * incumbent[1]]
     winner = min(clearly, key=lambda e: e[1][1]) if clearly else ranked[0]
     ranked = [winner] + sorted((e for e in ranked if e is not winner), key=lambda e: e[1][1])

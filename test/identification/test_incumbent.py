@@ -26,6 +26,7 @@ docs/model.md), so this test checks the rule, not a figure;
 
 from __future__ import annotations
 
+from contextlib import contextmanager
 from pathlib import Path
 import sys
 
@@ -81,19 +82,60 @@ def test_more_splits_only_with_a_floor_and_above_it(monkeypatch):
 def test_the_other_hold_ranks_the_starts_again_only_with_a_floor(monkeypatch):
     """rank_conventions: data-built starts under the other hold only above a given floor."""
     holds = []
-    real = incumbent.data_incumbent
+    real = incumbent._data_incumbent
 
     def spy(spec, *args):
         holds.append((spec.initial, spec.hold))
         return real(spec, *args)
 
-    monkeypatch.setattr(incumbent, 'data_incumbent', spy)
+    monkeypatch.setattr(incumbent, '_data_incumbent', spy)
     t, v, y = _training_part(63)
     spec = chain_spec('pressure')
     rec = Recording(t, v, y, 'pressure')
-    first = real(spec, t, v, y, IdentifySettings())
+    first = incumbent.data_incumbent(spec, t, v, y, IdentifySettings())
     for floor, other_hold_runs in ((None, 0), (1e-6, 2)):
         holds.clear()
         ranked = incumbent.rank_conventions(spec, rec, first, IdentifySettings(), floor)
         assert sum(h != spec.hold for _, h in holds) == other_hold_runs
         assert len(ranked) == 4       # two initial states x two holds
+
+
+def test_polished_side_by_side_gives_the_same_bits(monkeypatch):
+    """The data-built starts and the conventions polished in two workers: the same answer.
+
+    Every polish is computed as in one process and taken in the same order, so the
+    incumbent, the ranking and the evaluation counts are equal to the last bit
+    (the floor makes the five extra splits and the other hold's starts run too).
+    """
+    from hyst_id.identification.workers import forked_pool, mp_context
+    pools = []
+
+    @contextmanager
+    def seen_pool(n_workers):
+        with forked_pool(n_workers) as pool:
+            pools.append(pool)
+            yield pool
+
+    monkeypatch.setattr(incumbent, 'forked_pool', seen_pool)
+    t, v, y = _training_part(63)
+    spec = chain_spec('pressure')
+    rec = Recording(t, v, y, 'pressure')
+    outs = []
+    for workers in (1, 2):
+        pools.clear()
+        settings = IdentifySettings(workers=workers)
+        first = incumbent.data_incumbent(spec, t, v, y, settings, 1e-6)
+        ranked = incumbent.rank_conventions(spec, rec, first, settings, 1e-6)
+        outs.append((first, ranked))
+        assert len(pools) == 2
+        if workers == 1:
+            assert pools == [None, None]
+        elif mp_context().get_start_method() == 'fork':
+            assert all(p is not None for p in pools)
+    (first_a, ranked_a), (first_b, ranked_b) = outs
+    np.testing.assert_array_equal(first_a[0], first_b[0])
+    assert first_a[1:] == first_b[1:]
+    assert [r[0] for r in ranked_a] == [r[0] for r in ranked_b]
+    for (_, (xa, fa, na)), (_, (xb, fb, nb)) in zip(ranked_a, ranked_b):
+        np.testing.assert_array_equal(xa, xb)
+        assert (fa, na) == (fb, nb)
