@@ -16,7 +16,6 @@
 
 from __future__ import annotations
 
-from contextlib import contextmanager
 from dataclasses import replace
 from pathlib import Path
 import sys
@@ -155,7 +154,7 @@ def test_on_jump_is_called_before_each_jump(trap):
 
 @pytest.mark.parametrize('hops, floor_div', [(100, 1.0), (12, 3.9)])
 def test_jumps_polished_side_by_side_give_the_same_answer(trap, hops, floor_div,
-                                                          monkeypatch):
+                                                          pools_seen):
     """Two workers polish jumps speculatively; the run, its cost and the calls are the same.
 
     The trap improves on several jumps (so speculative jumps are dropped and made again);
@@ -166,16 +165,7 @@ def test_jumps_polished_side_by_side_give_the_same_answer(trap, hops, floor_div,
     rec, spec, run, floor = trap
     floor = floor if floor_div == 1.0 else run.er_percent / floor_div
     settings = IdentifySettings(hops=hops)
-    pools = []
-    forked_pool = hop_module.forked_pool
-
-    @contextmanager
-    def seen_pool(n_workers):
-        with forked_pool(n_workers) as pool:
-            pools.append(pool)
-            yield pool
-
-    monkeypatch.setattr(hop_module, 'forked_pool', seen_pool)
+    pools = pools_seen(hop_module)
     outs = []
     for workers in (1, 2):
         calls = []

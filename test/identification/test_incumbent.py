@@ -26,7 +26,6 @@ docs/model.md), so this test checks the rule, not a figure;
 
 from __future__ import annotations
 
-from contextlib import contextmanager
 from pathlib import Path
 import sys
 
@@ -100,23 +99,15 @@ def test_the_other_hold_ranks_the_starts_again_only_with_a_floor(monkeypatch):
         assert len(ranked) == 4       # two initial states x two holds
 
 
-def test_polished_side_by_side_gives_the_same_bits(monkeypatch):
+def test_polished_side_by_side_gives_the_same_bits(pools_seen):
     """The data-built starts and the conventions polished in two workers: the same answer.
 
     Every polish is computed as in one process and taken in the same order, so the
     incumbent, the ranking and the evaluation counts are equal to the last bit
     (the floor makes the five extra splits and the other hold's starts run too).
     """
-    from hyst_id.identification.workers import forked_pool, mp_context
-    pools = []
-
-    @contextmanager
-    def seen_pool(n_workers):
-        with forked_pool(n_workers) as pool:
-            pools.append(pool)
-            yield pool
-
-    monkeypatch.setattr(incumbent, 'forked_pool', seen_pool)
+    from hyst_id.identification.workers import mp_context
+    pools = pools_seen(incumbent)
     t, v, y = _training_part(63)
     spec = chain_spec('pressure')
     rec = Recording(t, v, y, 'pressure')
