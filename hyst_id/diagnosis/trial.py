@@ -28,7 +28,6 @@ not depend on the number of workers.
 from __future__ import annotations
 
 from dataclasses import replace
-import os
 from typing import Callable
 
 import numpy as np
@@ -42,7 +41,7 @@ from hyst_id.diagnosis.select import compare, Comparison, Data, evaluate, fit_mo
 from hyst_id.diagnosis.select import FitResult, polish
 from hyst_id.identification.chains import HOLDS
 from hyst_id.identification.domains import domains_from_data
-from hyst_id.identification.workers import map_in_processes
+from hyst_id.identification.workers import map_in_processes, n_processes
 from hyst_id.io.recording import Recording
 
 __all__ = ['polish_all', 'try_all', 'try_mechanism']
@@ -74,7 +73,7 @@ def try_all(mechs: list[Mechanism], current: FitResult, data: Data, ctx: Context
     list of Comparison
         One per mechanism, in the order of ``mechs``.
     """
-    workers = _processes(settings.workers, len(mechs))
+    workers = n_processes(settings.workers, len(mechs))
     if workers <= 1:
         comps = []
         for m in mechs:
@@ -120,15 +119,10 @@ def polish_all(pairs: list[tuple[ComposedModel, np.ndarray]], data: Data, max_nf
     ``workers`` as in :class:`DiagnoseSettings` (0: one per core); each polish is
     computed as in one process.
     """
-    n = _processes(workers, len(pairs))
+    n = n_processes(workers, len(pairs))
     if n <= 1:
         return [polish(model, data, x0, max_nfev=max_nfev) for model, x0 in pairs]
     return map_in_processes(_polish_one, [(model, data, x0, max_nfev) for model, x0 in pairs], n)
-
-
-def _processes(workers: int, n_tasks: int) -> int:
-    """Processes for ``n_tasks`` tasks: ``workers`` (0: one per core), at most one per task."""
-    return min(workers or (os.cpu_count() or 1), n_tasks)
 
 
 def _polish_one(model: ComposedModel, data: Data, x0: np.ndarray,

@@ -25,7 +25,6 @@ noise floor.
 from __future__ import annotations
 
 from dataclasses import replace
-import os
 from typing import Any, Callable
 
 import numpy as np
@@ -48,7 +47,7 @@ from hyst_id.identification.incumbent import (
 from hyst_id.identification.quality import assess
 from hyst_id.identification.refine import refine
 from hyst_id.identification.result import Identification, IdentifySettings, SeedRun
-from hyst_id.identification.workers import map_in_processes, WorkersStopped
+from hyst_id.identification.workers import map_in_processes, n_processes, WorkersStopped
 from hyst_id.io.recording import Recording, roundoff_probe, validate_recording
 from hyst_id.signals.noise import noise_floor_percent
 from hyst_id.solvers.gaass import GaassSolver
@@ -192,8 +191,7 @@ _STALL_FLOOR_FACTOR = 1.5
 
 
 def _n_workers(settings: IdentifySettings) -> int:
-    workers = settings.workers or (os.cpu_count() or 1)
-    return max(1, min(workers, len(settings.seeds)))
+    return n_processes(settings.workers, len(settings.seeds))
 
 
 def identify(recording: Recording, *, spec: ChainSpec | None = None,

@@ -21,16 +21,17 @@ searches on a subset of the samples (:func:`search_subset`).
 
 The polishes of one step are independent of each other; with
 ``settings.workers`` other than 1 they run in forked worker processes
-(:func:`hyst_id.identification.workers.forked_pool`; in this process when
-threads are running), each computed exactly as in one process and taken in
-the same order, so the answer does not depend on the number of workers.
+(:func:`polish_pool`; in the calling process with one worker, with threads
+running or where the platform cannot fork), each computed exactly as in one
+process and taken in the same order, so the answer does not depend on the
+number of workers.
 """
 
 from __future__ import annotations
 
 from concurrent.futures import ProcessPoolExecutor
+from contextlib import AbstractContextManager
 from dataclasses import replace
-import os
 
 import numpy as np
 from threadpoolctl import threadpool_limits
@@ -40,7 +41,7 @@ from hyst_id.identification.chains import ChainSpec, er_percent, HOLDS, INITIAL_
 from hyst_id.identification.refine import refine
 from hyst_id.identification.result import IdentifySettings
 from hyst_id.identification.starts import data_starts, MORE_SPLITS, SPLITS
-from hyst_id.identification.workers import forked_pool
+from hyst_id.identification.workers import forked_pool, n_processes
 from hyst_id.io.recording import Recording
 from hyst_id.signals.reversals import reversal_indices
 
@@ -76,13 +77,16 @@ def data_incumbent(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray,
         return _data_incumbent(spec, t_s, command, measurement, settings, floor_percent, pool)
 
 
-def polish_pool(settings: IdentifySettings):
-    """A forked pool of ``settings.workers`` processes (0: one per core), or None in one.
+def polish_pool(settings: IdentifySettings) -> AbstractContextManager[ProcessPoolExecutor | None]:
+    """A forked pool for the polishes, as many processes as identify's seeds get.
 
-    A context manager (:func:`hyst_id.identification.workers.forked_pool`): None
-    with one worker or when threads are running.
+    ``settings.workers`` (0: one per core), at most one per seed
+    (:func:`hyst_id.identification.workers.n_processes`). A context manager
+    (:func:`hyst_id.identification.workers.forked_pool`) that yields None, so
+    that the polishes run in the calling process, with one process, with
+    threads running or where the platform cannot fork.
     """
-    return forked_pool(settings.workers or (os.cpu_count() or 1))
+    return forked_pool(n_processes(settings.workers, len(settings.seeds)))
 
 
 def _data_incumbent(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray,
@@ -107,7 +111,7 @@ def _incumbent_of(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray,
                   measurement: np.ndarray, settings: IdentifySettings, splits: tuple,
                   pool: ProcessPoolExecutor | None = None
                   ) -> tuple[np.ndarray, float, int] | None:
-    """:func:`data_incumbent` over the data-built starts of ``splits``."""
+    """:func:`data_incumbent` over the data-built starts of ``splits``, polished in ``pool``."""
     try:
         starts = data_starts(spec, t_s, command, measurement, splits=splits)
     except (InvalidParametersError, ValueError):
@@ -143,13 +147,15 @@ def _incumbent_of(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray,
 
 def refined_each(pool: ProcessPoolExecutor | None, calls: list[tuple], **kwargs
                  ) -> list[tuple[np.ndarray, float, int]]:
-    """``refine(*call, **kwargs)`` of each call, in order; in ``pool``'s workers when given.
+    """``refine(*call, **kwargs)`` of each call, in order.
 
-    Each polish is computed as in one process (one BLAS thread), so the list
-    is the same with or without a pool.
+    In ``pool``'s workers when there is a pool and more than one call, else in
+    this process; always with one BLAS thread (a forked pool's workers have
+    one), so the list is the same with or without a pool.
     """
     if pool is None or len(calls) < 2:
-        return [refine(*call, **kwargs) for call in calls]
+        with threadpool_limits(limits=1):
+            return [refine(*call, **kwargs) for call in calls]
     futures = [pool.submit(refine, *call, **kwargs) for call in calls]
     return [f.result() for f in futures]
 

@@ -45,7 +45,8 @@ from threadpoolctl import threadpool_limits
 
 from hyst_id.errors import IdentificationError
 
-__all__ = ['POLL_S', 'WorkersStopped', 'forked_pool', 'map_in_processes', 'mp_context']
+__all__ = ['POLL_S', 'WorkersStopped', 'forked_pool', 'map_in_processes', 'mp_context',
+           'n_processes']
 
 #: How often a stop request is looked at while workers run [s].
 POLL_S = 0.2
@@ -66,6 +67,14 @@ def mp_context() -> Any:
     if 'fork' in multiprocessing.get_all_start_methods() and threading.active_count() == 1:
         return multiprocessing.get_context('fork')
     return multiprocessing.get_context('spawn')
+
+
+def n_processes(workers: int, n_tasks: int) -> int:
+    """Processes for ``n_tasks`` tasks: ``workers`` (0: one per core), at most one per task.
+
+    At least one (the calling process), also for no task.
+    """
+    return max(1, min(workers or (os.cpu_count() or 1), n_tasks))
 
 
 def _worker_init(parent_pid: int) -> None:

@@ -26,10 +26,14 @@ docs/model.md), so this test checks the rule, not a figure;
 
 from __future__ import annotations
 
+from contextlib import contextmanager
+import multiprocessing
 from pathlib import Path
+import subprocess
 import sys
 
 import numpy as np
+import pytest
 
 from hyst_id.identification import incumbent
 from hyst_id.identification.chains import chain_spec
@@ -99,15 +103,23 @@ def test_the_other_hold_ranks_the_starts_again_only_with_a_floor(monkeypatch):
         assert len(ranked) == 4       # two initial states x two holds
 
 
-def test_polished_side_by_side_gives_the_same_bits(pools_seen):
+def side_by_side() -> None:
     """The data-built starts and the conventions polished in two workers: the same answer.
 
-    Every polish is computed as in one process and taken in the same order, so the
-    incumbent, the ranking and the evaluation counts are equal to the last bit
-    (the floor makes the five extra splits and the other hold's starts run too).
+    Run by :func:`test_polished_side_by_side_gives_the_same_bits` in a fresh
+    process, which has one thread, so that the two workers are forked (a test
+    process may have threads left by earlier tests, and the polishes then run
+    in it). Raises AssertionError when the pool was not used or a bit differs.
     """
-    from hyst_id.identification.workers import mp_context
-    pools = pools_seen(incumbent)
+    real, pools = incumbent.forked_pool, []
+
+    @contextmanager
+    def seen(n_workers):
+        with real(n_workers) as pool:
+            pools.append(pool)
+            yield pool
+
+    incumbent.forked_pool = seen
     t, v, y = _training_part(63)
     spec = chain_spec('pressure')
     rec = Recording(t, v, y, 'pressure')
@@ -120,9 +132,9 @@ def test_polished_side_by_side_gives_the_same_bits(pools_seen):
         outs.append((first, ranked))
         assert len(pools) == 2
         if workers == 1:
-            assert pools == [None, None]
-        elif mp_context().get_start_method() == 'fork':
-            assert all(p is not None for p in pools)
+            assert pools == [None, None], 'one worker: polished in this process'
+        else:
+            assert all(p is not None for p in pools), 'two workers: polished in the pool'
     (first_a, ranked_a), (first_b, ranked_b) = outs
     np.testing.assert_array_equal(first_a[0], first_b[0])
     assert first_a[1:] == first_b[1:]
@@ -130,3 +142,36 @@ def test_polished_side_by_side_gives_the_same_bits(pools_seen):
     for (_, (xa, fa, na)), (_, (xb, fb, nb)) in zip(ranked_a, ranked_b):
         np.testing.assert_array_equal(xa, xb)
         assert (fa, na) == (fb, nb)
+
+
+@pytest.mark.skipif('fork' not in multiprocessing.get_all_start_methods(),
+                    reason='no fork on this platform: the polishes run in one process')
+def test_polished_side_by_side_gives_the_same_bits():
+    """Every polish is computed as in one process and taken in the same order.
+
+    So the incumbent, the ranking and the evaluation counts are equal to the
+    last bit with one worker and two (the floor of 1e-6 makes the five extra
+    splits and the other hold's starts run too); :func:`side_by_side` in a
+    fresh process.
+    """
+    here = Path(__file__).resolve().parent
+    code = (f'import sys; sys.path.insert(0, {str(here)!r}); '
+            'import test_incumbent; test_incumbent.side_by_side()')
+    done = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True,
+                          timeout=600)
+    assert done.returncode == 0, done.stderr[-3000:]
+
+
+def test_the_polishes_get_as_many_processes_as_the_seeds(monkeypatch):
+    """The rule of identify: ``workers`` (0: one per core), at most one per seed, at least one."""
+    import os
+
+    from hyst_id.identification.workers import n_processes
+    monkeypatch.setattr(os, 'cpu_count', lambda: 8)
+    assert [n_processes(w, n) for w, n in ((0, 2), (0, 12), (3, 2), (1, 5), (4, 0))] == \
+        [2, 8, 2, 1, 1]
+    asked = []
+    monkeypatch.setattr(incumbent, 'forked_pool', lambda n: asked.append(n))
+    for seeds, workers in (((0,), 0), ((0, 1), 0), ((0, 1, 2), 2)):
+        incumbent.polish_pool(IdentifySettings(seeds=seeds, workers=workers))
+    assert asked == [1, 2, 2]
