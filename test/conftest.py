@@ -64,28 +64,6 @@ def simulated():
     return get
 
 
-@pytest.fixture
-def pools_seen(monkeypatch):
-    """``watch(module)``: the pools ``module.forked_pool`` yields from now on, in a list.
-
-    None for each one the module polished without (one worker, or no safe fork).
-    """
-    def watch(module) -> list:
-        pools: list = []
-        real = module.forked_pool
-
-        @contextlib.contextmanager
-        def seen(n_workers):
-            with real(n_workers) as pool:
-                pools.append(pool)
-                yield pool
-
-        monkeypatch.setattr(module, 'forked_pool', seen)
-        return pools
-
-    return watch
-
-
 @pytest.fixture(autouse=True)
 def _no_kept_searches():
     """Every test starts without the family swaps' kept searches of earlier tests."""

@@ -17,6 +17,7 @@
 from __future__ import annotations
 
 from dataclasses import replace
+import multiprocessing
 from pathlib import Path
 import sys
 
@@ -46,6 +47,11 @@ TRAP_163 = np.array([
 
 @pytest.fixture(scope='module')
 def trap():
+    return make_trap()
+
+
+def make_trap() -> tuple:
+    """Reference family #163, its chain spec, the trapped run and the true floor."""
     case = FAMILY.draw_case(163)
     # through the round-off probe, as identify's input is (HYST_ID_ROUNDOFF_PROBE)
     rec = roundoff_probe(Recording(case.t_s, case.command, case.measurement, case.channel,
@@ -152,20 +158,21 @@ def test_on_jump_is_called_before_each_jump(trap):
     assert all(c[2] <= run.er_percent * (1 + 1e-12) for c in calls)
 
 
-@pytest.mark.parametrize('hops, floor_div', [(100, 1.0), (12, 3.9)])
-def test_jumps_polished_side_by_side_give_the_same_answer(trap, hops, floor_div,
-                                                          pools_seen):
+def side_by_side(hops: int, floor_div: float) -> None:
     """Two workers polish jumps speculatively; the run, its cost and the calls are the same.
 
-    The trap improves on several jumps (so speculative jumps are dropped and made again);
-    a floor it cannot reach makes every jump.
+    Run by :func:`test_jumps_polished_side_by_side_give_the_same_answer` in a
+    fresh process, which has one thread, so that the two workers are forked (a
+    test process may have threads left by earlier tests, and the jumps are
+    then polished in it). Raises AssertionError when the pool was not used or
+    anything differs.
     """
     import hyst_id.identification.hop as hop_module
-    from hyst_id.identification.workers import mp_context
-    rec, spec, run, floor = trap
+    from pool_watch import watch_pools
+    rec, spec, run, floor = make_trap()
     floor = floor if floor_div == 1.0 else run.er_percent / floor_div
     settings = IdentifySettings(hops=hops)
-    pools = pools_seen(hop_module)
+    pools = watch_pools(hop_module)
     outs = []
     for workers in (1, 2):
         calls = []
@@ -173,14 +180,27 @@ def test_jumps_polished_side_by_side_give_the_same_answer(trap, hops, floor_div,
                                   on_jump=lambda *a, c=calls: c.append(a))
         outs.append((out, nfev, calls))
     (a, nfev_a, calls_a), (b, nfev_b, calls_b) = outs
-    assert pools[0] is None      # one worker: polished here, one after the other
-    if mp_context().get_start_method() == 'fork':
-        assert pools[1] is not None      # two: polished in the forked pool
+    assert pools[0] is None, 'one worker: polished here, one after the other'
+    assert pools[1] is not None, 'two: polished in the forked pool'
     assert nfev_a == nfev_b and calls_a == calls_b
     assert (a is None) == (b is None)
     if a is not None:
         np.testing.assert_array_equal(a.x_raw, b.x_raw)
         assert a.fun == b.fun
+
+
+@pytest.mark.skipif('fork' not in multiprocessing.get_all_start_methods(),
+                    reason='no fork on this platform: the jumps are polished in one process')
+@pytest.mark.parametrize('hops, floor_div', [(100, 1.0), (12, 3.9)])
+def test_jumps_polished_side_by_side_give_the_same_answer(hops, floor_div):
+    """:func:`side_by_side` in a fresh process.
+
+    The trap improves on several jumps (so speculative jumps are dropped and made
+    again); a floor it cannot reach makes every jump.
+    """
+    from pool_watch import in_fresh_process
+    done = in_fresh_process(__file__, f'side_by_side({hops}, {floor_div})')
+    assert done.returncode == 0, done.stderr[-3000:]
 
 
 def test_a_stop_while_jumps_are_polished_side_by_side_ends_the_workers(trap):

@@ -26,10 +26,8 @@ docs/model.md), so this test checks the rule, not a figure;
 
 from __future__ import annotations
 
-from contextlib import contextmanager
 import multiprocessing
 from pathlib import Path
-import subprocess
 import sys
 
 import numpy as np
@@ -111,15 +109,8 @@ def side_by_side() -> None:
     process may have threads left by earlier tests, and the polishes then run
     in it). Raises AssertionError when the pool was not used or a bit differs.
     """
-    real, pools = incumbent.forked_pool, []
-
-    @contextmanager
-    def seen(n_workers):
-        with real(n_workers) as pool:
-            pools.append(pool)
-            yield pool
-
-    incumbent.forked_pool = seen
+    from pool_watch import watch_pools
+    pools = watch_pools(incumbent)
     t, v, y = _training_part(63)
     spec = chain_spec('pressure')
     rec = Recording(t, v, y, 'pressure')
@@ -154,11 +145,8 @@ def test_polished_side_by_side_gives_the_same_bits():
     splits and the other hold's starts run too); :func:`side_by_side` in a
     fresh process.
     """
-    here = Path(__file__).resolve().parent
-    code = (f'import sys; sys.path.insert(0, {str(here)!r}); '
-            'import test_incumbent; test_incumbent.side_by_side()')
-    done = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True,
-                          timeout=600)
+    from pool_watch import in_fresh_process
+    done = in_fresh_process(__file__, 'side_by_side()')
     assert done.returncode == 0, done.stderr[-3000:]
 
 
