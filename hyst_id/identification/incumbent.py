@@ -109,8 +109,7 @@ def _data_incumbent(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray,
 
 def _incumbent_of(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray,
                   measurement: np.ndarray, settings: IdentifySettings, splits: tuple,
-                  pool: ProcessPoolExecutor | None = None
-                  ) -> tuple[np.ndarray, float, int] | None:
+                  pool: ProcessPoolExecutor | None) -> tuple[np.ndarray, float, int] | None:
     """:func:`data_incumbent` over the data-built starts of ``splits``, polished in ``pool``."""
     try:
         starts = data_starts(spec, t_s, command, measurement, splits=splits)
