@@ -148,7 +148,7 @@ def hop_with_cost(spec: ChainSpec, rec: Recording, best: SeedRun, settings: Iden
                 done = k + 1
                 if k not in starts:
                     continue
-                x_new, f_new, n = (polished[k].result() if pool is not None
+                x_new, f_new, n = (pool.result(polished[k]) if pool is not None
                                    else _polish(spec, starts[k], t_s, v, y))
                 nfev += n
                 if f_new < fun * (1.0 - 1e-9):

@@ -29,7 +29,6 @@ number of workers.
 
 from __future__ import annotations
 
-from concurrent.futures import ProcessPoolExecutor
 from contextlib import AbstractContextManager
 from dataclasses import replace
 
@@ -41,7 +40,7 @@ from hyst_id.identification.chains import ChainSpec, er_percent, HOLDS, INITIAL_
 from hyst_id.identification.refine import refine
 from hyst_id.identification.result import IdentifySettings
 from hyst_id.identification.starts import data_starts, MORE_SPLITS, SPLITS
-from hyst_id.identification.workers import forked_pool, n_processes
+from hyst_id.identification.workers import forked_pool, ForkedPool, n_processes
 from hyst_id.io.recording import Recording
 from hyst_id.signals.reversals import reversal_indices
 
@@ -77,7 +76,7 @@ def data_incumbent(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray,
         return _data_incumbent(spec, t_s, command, measurement, settings, floor_percent, pool)
 
 
-def polish_pool(settings: IdentifySettings) -> AbstractContextManager[ProcessPoolExecutor | None]:
+def polish_pool(settings: IdentifySettings) -> AbstractContextManager[ForkedPool | None]:
     """A forked pool for the polishes, as many processes as identify's seeds get.
 
     ``settings.workers`` (0: one per core), at most one per seed
@@ -91,7 +90,7 @@ def polish_pool(settings: IdentifySettings) -> AbstractContextManager[ProcessPoo
 
 def _data_incumbent(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray,
                     measurement: np.ndarray, settings: IdentifySettings,
-                    floor_percent: float | None, pool: ProcessPoolExecutor | None
+                    floor_percent: float | None, pool: ForkedPool | None
                     ) -> tuple[np.ndarray, float, int] | None:
     """:func:`data_incumbent` with its pool (None: this process)."""
     with threadpool_limits(limits=1):
@@ -109,7 +108,7 @@ def _data_incumbent(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray,
 
 def _incumbent_of(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray,
                   measurement: np.ndarray, settings: IdentifySettings, splits: tuple,
-                  pool: ProcessPoolExecutor | None) -> tuple[np.ndarray, float, int] | None:
+                  pool: ForkedPool | None) -> tuple[np.ndarray, float, int] | None:
     """:func:`data_incumbent` over the data-built starts of ``splits``, polished in ``pool``."""
     try:
         starts = data_starts(spec, t_s, command, measurement, splits=splits)
@@ -144,7 +143,7 @@ def _incumbent_of(spec: ChainSpec, t_s: np.ndarray, command: np.ndarray,
     return (best_x, float(best_fun), nfev) if best_x is not None else None
 
 
-def refined_each(pool: ProcessPoolExecutor | None, calls: list[tuple], **kwargs
+def refined_each(pool: ForkedPool | None, calls: list[tuple], **kwargs
                  ) -> list[tuple[np.ndarray, float, int]]:
     """``refine(*call, **kwargs)`` of each call, in order.
 
@@ -156,11 +155,11 @@ def refined_each(pool: ProcessPoolExecutor | None, calls: list[tuple], **kwargs
         with threadpool_limits(limits=1):
             return [refine(*call, **kwargs) for call in calls]
     futures = [pool.submit(refine, *call, **kwargs) for call in calls]
-    return [f.result() for f in futures]
+    return [pool.result(f) for f in futures]
 
 
 def best_polished(spec: ChainSpec, starts: list[np.ndarray], data: tuple, max_nfev: int, *,
-                  pool: ProcessPoolExecutor | None = None) -> tuple[np.ndarray, int]:
+                  pool: ForkedPool | None = None) -> tuple[np.ndarray, int]:
     """The best of ``starts`` each refined on ``data`` (a search subset), and the evaluations.
 
     ``pool``: worker processes to polish in (:func:`refined_each`).

@@ -25,7 +25,8 @@ from the main thread with Python's default Ctrl-C handler, a SIGINT is only
 noted while the pool runs and raised as :class:`KeyboardInterrupt` at the
 next poll: raised asynchronously it can land while the executor holds one of
 its locks, and ending the pool then deadlocks (seen once in 100 stops under
-load by ``bench/stop_stress.py``).
+load by ``bench/stop_stress.py``). :func:`forked_pool` defers Ctrl-C the
+same way: its :meth:`ForkedPool.result` waits in polls and raises it there.
 """
 
 from __future__ import annotations
@@ -45,8 +46,8 @@ from threadpoolctl import threadpool_limits
 
 from hyst_id.errors import IdentificationError
 
-__all__ = ['POLL_S', 'WorkersStopped', 'forked_pool', 'map_in_processes', 'mp_context',
-           'n_processes']
+__all__ = ['POLL_S', 'ForkedPool', 'WorkersStopped', 'forked_pool', 'map_in_processes',
+           'mp_context', 'n_processes']
 
 #: How often a stop request is looked at while workers run [s].
 POLL_S = 0.2
@@ -197,23 +198,51 @@ def _ended_on_error(pool: ProcessPoolExecutor) -> Iterator[ProcessPoolExecutor]:
         raise
 
 
+class ForkedPool(ProcessPoolExecutor):
+    """A process pool whose :meth:`result` raises a deferred Ctrl-C at its next poll.
+
+    What :func:`forked_pool` yields. Wait for a task with ``pool.result(future)``,
+    not ``future.result()``: while the pool is open a Ctrl-C is only noted
+    (as in :func:`map_in_processes`), so that it cannot land while the
+    executor holds a lock, and :meth:`result` raises it.
+    """
+
+    def __init__(self, *args: Any, interrupted: Callable[[], bool], **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self._interrupted = interrupted
+
+    def result(self, future: Future) -> Any:
+        """``future.result()``, raising a noted Ctrl-C as :class:`KeyboardInterrupt` first."""
+        while not future.done():
+            if self._interrupted():
+                raise KeyboardInterrupt
+            wait([future], timeout=POLL_S)
+        if self._interrupted():
+            raise KeyboardInterrupt
+        return future.result()
+
+
 @contextmanager
-def forked_pool(n_workers: int) -> Iterator[ProcessPoolExecutor | None]:
+def forked_pool(n_workers: int) -> Iterator[ForkedPool | None]:
     """A pool of ``n_workers`` forked processes for a loop that submits as it goes.
 
     Yields ``None`` when a pool would not pay: one worker, or no safe fork
     (threads running: spawning would cost seconds of imports per pool). On
     leaving, queued tasks are dropped; on an error (also Ctrl-C or a stop
     request raised by the loop) the workers are ended at once. Submitted
-    functions run with one BLAS thread, as the seeds' do.
+    functions run with one BLAS thread, as the seeds' do. While the pool is
+    open a Ctrl-C in the main thread is noted and raised by
+    :meth:`ForkedPool.result`, or on leaving the block.
     """
     ctx = mp_context()
     if n_workers < 2 or ctx.get_start_method() != 'fork':
         yield None
         return
-    with threadpool_limits(limits=1):
-        pool = ProcessPoolExecutor(max_workers=n_workers, mp_context=ctx,
-                                   initializer=_worker_init, initargs=(os.getpid(),))
+    with threadpool_limits(limits=1), _sigint_deferred() as interrupted:
+        pool = ForkedPool(max_workers=n_workers, mp_context=ctx, initializer=_worker_init,
+                          initargs=(os.getpid(),), interrupted=interrupted)
         with _ended_on_error(pool):
             yield pool
+            if interrupted():
+                raise KeyboardInterrupt
         pool.shutdown(wait=True, cancel_futures=True)
