@@ -14,11 +14,13 @@
 
 """Find a fleet's recordings, run one task per recording on an engine, resume.
 
-Engines: a local process pool (default), or a Dask distributed cluster
-(``address``: a scheduler address such as ``tcp://10.0.0.5:8786``, or
-``local`` for a cluster started on this machine), used through its
-:class:`concurrent.futures.Executor` interface (``Client.get_executor``), so
-the same loop drives both and no scheduling is written here. Dask rather
+Engines: a local process pool (default: identify's
+:func:`~hyst_id.identification.workers.map_in_processes`, whose workers leave
+Ctrl-C to the parent, die with it and are ended at once on an interrupt),
+or a Dask distributed cluster (``address``: a scheduler address such as
+``tcp://10.0.0.5:8786``, or ``local`` for a cluster started on this
+machine), used through its :class:`concurrent.futures.Executor` interface
+(``Client.get_executor``), so no scheduling is written here. Dask rather
 than Ray: it installs from PyPI as pure Python (Ray's wheels are large and
 platform-bound), joins an existing cluster from an address alone, and its
 executor is the standard one.
@@ -26,7 +28,7 @@ executor is the standard one.
 
 from __future__ import annotations
 
-from concurrent.futures import as_completed, Executor, ProcessPoolExecutor
+from concurrent.futures import as_completed, Executor
 from dataclasses import asdict, dataclass
 import glob
 import hashlib
@@ -37,7 +39,7 @@ import time
 from typing import Any, Callable, Iterable
 
 from hyst_id.errors import ConfigError, HystIdError
-from hyst_id.identification.workers import mp_context
+from hyst_id.identification.workers import map_in_processes
 
 __all__ = ['FleetOptions', 'find_recordings', 'fleet_task', 'result_path', 'run_fleet']
 
@@ -132,12 +134,7 @@ def fleet_task(path: str, options: FleetOptions) -> dict:
     return doc
 
 
-def _executor(address: str | None, workers: int) -> tuple[Executor, Callable[[], None]]:
-    if not address:
-        # fork where safe (no threads: the CLI's bar starts none), as identify's pools
-        pool = ProcessPoolExecutor(max_workers=workers or os.cpu_count() or 1,
-                                   mp_context=mp_context())
-        return pool, lambda: pool.shutdown(wait=True, cancel_futures=True)
+def _dask_executor(address: str, workers: int) -> tuple[Executor, Callable[[], None]]:
     try:
         from distributed import Client, LocalCluster
     except ImportError:
@@ -180,17 +177,25 @@ def run_fleet(recordings: list[Path], out_dir: str | Path, options: FleetOptions
             docs[str(rec)] = {**old, 'resumed': True}
         else:
             todo.append(rec)
-    if todo:
-        executor, close = _executor(address, workers)
+    arrived = 0
+
+    def keep(doc: dict) -> None:
+        nonlocal arrived
+        arrived += 1
+        _write(result_path(out_dir, Path(doc['recording'])), doc)
+        docs[doc['recording']] = doc
+        if progress:
+            progress(arrived, len(todo), doc)
+
+    if todo and not address:
+        map_in_processes(fleet_task, [(str(rec), options) for rec in todo],
+                         workers or os.cpu_count() or 1, on_result=keep)
+    elif todo:
+        executor, close = _dask_executor(address, workers)
         try:
-            futures = {executor.submit(fleet_task, str(rec), options): rec for rec in todo}
-            for k, fut in enumerate(as_completed(futures), 1):
-                rec = futures[fut]
-                doc = fut.result()
-                _write(result_path(out_dir, rec), doc)
-                docs[str(rec)] = doc
-                if progress:
-                    progress(k, len(todo), doc)
+            for fut in as_completed([executor.submit(fleet_task, str(rec), options)
+                                     for rec in todo]):
+                keep(fut.result())
         finally:
             close()
     return [docs[str(rec)] for rec in recordings]

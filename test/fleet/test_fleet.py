@@ -24,6 +24,11 @@ without excitation are in the same fleet.
 from __future__ import annotations
 
 import json
+import os
+import signal
+import subprocess
+import sys
+import time
 
 import numpy as np
 import pytest
@@ -126,17 +131,58 @@ def test_fleet_on_a_local_dask_cluster(fleet_dir, tmp_path):
                       'junk.mcap': 'error', 'flat.csv': 'error'}
 
 
-def test_the_local_pool_starts_its_workers_as_identify_does(monkeypatch):
-    """Fork where no other thread runs, spawn otherwise (workers.mp_context), not the default."""
-    import multiprocessing
-    import threading
+_INTERRUPTED_FLEET = r"""
+import os, signal, sys, time
+from pathlib import Path
+signal.signal(signal.SIGINT, signal.default_int_handler)   # Ctrl-C as in a terminal
+from hyst_id.fleet import FleetOptions, run as fleet_run
 
-    from hyst_id.fleet import run as fleet_run
-    alone = 'fork' if 'fork' in multiprocessing.get_all_start_methods() else 'spawn'
-    for threads, method in ((1, alone), (3, 'spawn')):
-        monkeypatch.setattr(threading, 'active_count', lambda n=threads: n)
-        pool, close = fleet_run._executor(None, 1)
-        try:
-            assert pool._mp_context.get_start_method() == method
-        finally:
-            close()
+
+def task(path, options):
+    if path.endswith('fast'):
+        return {'recording': path, 'status': 'ok'}
+    print('slow', os.getpid(), flush=True)
+    time.sleep(60.0)
+
+
+fleet_run.fleet_task = task
+out = Path(sys.argv[1])
+fleet_run.run_fleet([out / 'fast', out / 'slow1', out / 'slow2'], out, FleetOptions(),
+                    workers=2)
+"""
+
+
+@pytest.mark.skipif(not sys.platform.startswith('linux'), reason='fork, /proc')
+def test_an_interrupted_local_fleet_keeps_what_arrived_and_ends_its_workers(tmp_path):
+    """Ctrl-C: the parent ends its workers at once (they ignore it) and keeps finished rows."""
+    proc = subprocess.Popen([sys.executable, '-c', _INTERRUPTED_FLEET, str(tmp_path)],
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    try:
+        workers = [int(proc.stdout.readline().split()[1]) for _ in range(2)]
+        proc.send_signal(signal.SIGINT)
+        t0 = time.monotonic()
+        proc.wait(timeout=20)
+        took_s = time.monotonic() - t0
+        out = proc.stdout.read()
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode != 0 and 'KeyboardInterrupt' in out, out[-2000:]
+    assert took_s < 10.0, f'{took_s:.1f} s from the Ctrl-C to the exit (tasks sleep 60 s)'
+    deadline = time.monotonic() + 10.0
+    while any(_alive(p) for p in workers) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    left = [p for p in workers if _alive(p)]
+    for pid in left:
+        os.kill(pid, signal.SIGKILL)
+    assert not left, f'worker(s) {left} outlived the interrupted fleet'
+    kept = [json.loads(f.read_text()) for f in (tmp_path / 'recordings').glob('*.json')]
+    assert [d['recording'] for d in kept] == [str(tmp_path / 'fast')]
+
+
+def _alive(pid: int) -> bool:
+    try:
+        with open(f'/proc/{pid}/stat') as f:
+            return f.read().rsplit(')', 1)[1].split()[0] != 'Z'
+    except OSError:
+        return False
