@@ -17,6 +17,8 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
+import sys
 from typing import Any
 
 from hyst_id.errors import ConfigError
@@ -25,7 +27,8 @@ from hyst_id.identification.chains import CHAIN_NAMES, ChainSpec
 from hyst_id.io.recording import Recording
 
 __all__ = ['add_output_arguments', 'add_recording_arguments', 'add_settings_arguments',
-           'load_recording', 'make_spec', 'make_settings', 'progress_bar']
+           'load_recording', 'make_spec', 'make_settings', 'parse_columns', 'prepare_outputs',
+           'progress_bar']
 
 
 def add_recording_arguments(parser: argparse.ArgumentParser) -> None:
@@ -34,7 +37,9 @@ def add_recording_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--channel', choices=tuple(CHAIN_NAMES), default='position',
                         help='measured channel (default: position)')
     parser.add_argument('--params', metavar='YAML',
-                        help='params file: topics/fields for bags, domains, GAASS settings')
+                        help='params file: the topics and message fields of a bag (a node '
+                        "params file works; its node parameters are the node's, GAASS "
+                        'settings and domains here come from the flags)')
     parser.add_argument('--columns', metavar='T,CMD,MEAS', default=None,
                         help='CSV columns by name or 0-based index (default t,command,'
                         'measurement)')
@@ -101,17 +106,68 @@ def add_settings_arguments(parser: argparse.ArgumentParser, identify: bool = Tru
 def load_recording(args: argparse.Namespace) -> Recording:
     """Read and validate the recording named on the command line."""
     from hyst_id.io.readers import read_recording
-    from hyst_id.io.topics import load_topic_config
+    from hyst_id.io.topics import load_topic_config, node_parameters_in
 
     topics = load_topic_config(args.params, args.channel) if args.params else None
-    columns = None
-    if args.columns:
-        parts = [c.strip() for c in args.columns.split(',')]
-        if len(parts) != 3:
-            raise ConfigError('--columns needs three entries: time, command, measurement')
-        columns = tuple(int(c) if c.lstrip('-').isdigit() else c for c in parts)
-    return read_recording(args.recording, args.channel, topics=topics, columns=columns,
-                          time_scale=args.time_scale)
+    unused = node_parameters_in(args.params) if args.params else []
+    if unused:
+        print(f'note: {args.params}: only topics and fields are read here; node parameters '
+              f'{", ".join(unused[:8])}{" ..." if len(unused) > 8 else ""} are not used (give '
+              'GAASS settings and domains as flags)', file=sys.stderr)
+    return read_recording(args.recording, args.channel, topics=topics,
+                          columns=parse_columns(args.columns), time_scale=args.time_scale)
+
+
+def parse_columns(text: str | None) -> tuple[int | str, ...] | None:
+    """``--columns T,CMD,MEAS``: three different column names or 0-based indices.
+
+    None (the reader's default columns) for no text.
+    """
+    if not text:
+        return None
+    parts = [c.strip() for c in text.split(',')]
+    if len(parts) != 3:
+        raise ConfigError('--columns needs three entries: time, command, measurement')
+    columns = tuple(int(c) if c.lstrip('-').isdigit() else c for c in parts)
+    if len(set(columns)) < 3:
+        raise ConfigError(f'--columns {text}: time, command and measurement must be three '
+                          'different columns')
+    return columns
+
+
+def prepare_outputs(args: argparse.Namespace, *, plot_is_folder: bool) -> None:
+    """Before any work: make the folders the outputs go into, refuse paths that cannot be.
+
+    A file output (``--json``, ``--params-out``, ``--sim-out``) that names a
+    folder or lies under a file, and a ``--plot`` folder that is a file, are
+    a :class:`ConfigError` (exit 2) before the identification runs, not an
+    error after it. ``plot_is_folder``: ``--plot`` names a folder (identify);
+    else a name with a suffix is a file (diagnose's ``FILE.png|DIR``).
+    """
+    for opt in ('json', 'params_out', 'sim_out'):
+        value = getattr(args, opt, None)
+        if value:
+            flag = '--' + opt.replace('_', '-')
+            if Path(value).is_dir():
+                raise ConfigError(f'{flag} {value}: a folder; give a file name')
+            _make_folder(Path(value).parent, flag, value)
+    plot = getattr(args, 'plot', None)
+    if plot:
+        path = Path(plot)
+        if plot_is_folder or path.is_dir() or path.suffix == '':
+            _make_folder(path, '--plot', plot)
+        else:
+            _make_folder(path.parent, '--plot', plot)
+
+
+def _make_folder(folder: Path, flag: str, value: str) -> None:
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except (FileExistsError, NotADirectoryError):
+        raise ConfigError(f'{flag} {value}: {folder} is a file, not a folder') from None
+    except OSError as exc:
+        raise ConfigError(f'{flag} {value}: cannot make the folder {folder}: '
+                          f'{exc.strerror}') from None
 
 
 def make_settings(args: argparse.Namespace) -> IdentifySettings:

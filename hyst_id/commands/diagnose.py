@@ -38,6 +38,7 @@ from hyst_id.commands.common import (
     add_settings_arguments,
     load_recording,
     make_spec,
+    prepare_outputs,
 )
 from hyst_id.errors import ConfigError
 
@@ -78,9 +79,14 @@ def _settings(args: argparse.Namespace):
         raise ConfigError('--max-mechanisms must be at least 1')
     if args.hops < 0:
         raise ConfigError('--hops must be at least 0')
+    if args.workers < 0:
+        raise ConfigError(f'--workers must be >= 0 (0: one per core), got {args.workers}')
     mechs = None
-    if args.mechanisms:
-        mechs = tuple(m.strip() for m in args.mechanisms.split(',') if m.strip())
+    if args.mechanisms is not None:
+        mechs = tuple(m.strip() for m in args.mechanisms.split(','))
+        if not all(mechs):
+            raise ConfigError(f'--mechanisms {args.mechanisms!r}: an empty name; give ids '
+                              'separated by commas (leave the option out for all of them)')
         get_mechanisms(mechs)
     return DiagnoseSettings(
         train_fraction=args.train_fraction,
@@ -91,7 +97,7 @@ def _settings(args: argparse.Namespace):
 
 
 def _write_params(diag, path: str) -> None:
-    from hyst_id.compensation.params_file import write_compensator_params
+    from hyst_id.compensation.params_file import command_limits_for, write_compensator_params
     from hyst_id.diagnosis.export import compensator_set
     from hyst_id.errors import InvalidParametersError
 
@@ -104,7 +110,11 @@ def _write_params(diag, path: str) -> None:
                           '`hyst-id identify --params-out`') from None
     values = {'channel': diag.channel, 'er_percent': diag.final.er_holdout_percent,
               **model.as_mapping(), 'augment': aug}
-    write_compensator_params(values, path)
+    limits = command_limits_for(diag.command)
+    write_compensator_params(values, path, command_limits=limits)
+    if limits is not None:
+        print(f'compensator: min_command {limits[0]:g}, max_command {limits[1]:g} (the '
+              "recording's commands leave the node's default 4-20)", file=sys.stderr)
     diag.extra['compensator'] = {'params_out': str(path),
                                  'applied': [{'mechanism': m, 'how': how} for m, how in applied]}
     for mech, how in applied:
@@ -121,7 +131,11 @@ def run(args: argparse.Namespace) -> int:
     settings = _settings(args)
     if not 0.0 < args.train_fraction < 1.0:
         raise ConfigError(f'--train-fraction must be in (0, 1), got {args.train_fraction}')
+    if args.sim_out and not args.sim:
+        raise ConfigError('--sim-out names where the diagnosed simulator params go: it needs '
+                          '--sim PARAMS.yaml')
     rec = load_recording(args)
+    prepare_outputs(args, plot_is_folder=False)
     say = None if args.quiet else (lambda msg: print(f'[diagnose] {msg}', file=sys.stderr))
     print(f'{rec.source}: {rec.n_samples} samples over {rec.duration_s:.1f} s, channel '
           f'{rec.channel}', file=sys.stderr)

@@ -18,14 +18,16 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 from pathlib import Path
 import re
 import sys
 
-from hyst_id.commands.common import progress_bar
+from hyst_id.commands.common import parse_columns, progress_bar
 from hyst_id.errors import ConfigError
 from hyst_id.fleet import find_recordings, FleetOptions, loop_trends, run_fleet, write_table
 from hyst_id.fleet.table import fleet_rows
+from hyst_id.identification.config import make_settings
 from hyst_id.io.recording import CHANNELS
 
 __all__ = ['add_arguments', 'run']
@@ -54,6 +56,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--valve-regex', metavar='REGEX', help='the valve of a recording: '
                         'group 1 of REGEX searched in its path (default: the name of the '
                         'parent directory)')
+    parser.add_argument('--columns', metavar='T,CMD,MEAS', default=None,
+                        help='CSV columns by name or 0-based index (default t,command,'
+                        'measurement)')
+    parser.add_argument('--time-scale', type=float, default=None,
+                        help='multiply the CSV time column by this to get seconds')
     parser.add_argument('--no-progress', action='store_true', help='no progress bar')
 
 
@@ -73,6 +80,14 @@ def _valve_of(regex: str):
 
 def run(args: argparse.Namespace) -> int:
     """Run the fleet; exit 0 when every recording was identified, 1 when some failed."""
+    make_settings(seeds=args.seeds, generations=args.generations, workers=args.workers)
+    columns = parse_columns(args.columns)
+    if args.time_scale is not None and not (math.isfinite(args.time_scale)
+                                            and args.time_scale > 0.0):
+        raise ConfigError(f'--time-scale must be a finite number > 0, got {args.time_scale}')
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise ConfigError(f'--out {args.out}: a file, not a folder')
     recordings = find_recordings(args.inputs)
     if not recordings:
         raise ConfigError(f'no recordings found under {", ".join(args.inputs)}')
@@ -83,7 +98,8 @@ def run(args: argparse.Namespace) -> int:
     valve_of = _valve_of(args.valve_regex) if args.valve_regex else None
     options = FleetOptions(channel=args.channel, seeds=args.seeds,
                            generations=args.generations, model=args.model,
-                           diagnose=args.diagnose, topics=topics)
+                           diagnose=args.diagnose, topics=topics, columns=columns,
+                           time_scale=args.time_scale)
     bar = None
     if not args.no_progress:
         bar = progress_bar(total=len(recordings), unit='rec', desc='fleet')
@@ -110,8 +126,9 @@ def run(args: argparse.Namespace) -> int:
     bad = [r for r in rows if r['status'] != 'ok']
     resumed = sum(1 for d in docs if d.get('resumed'))
     print(f'{len(ok)} identified ({resumed} from an earlier run), {len(bad)} failed')
-    for r in bad:
-        print(f'  failed: {r["recording"]}: {r["error"]}')
+    for r in bad:     # a reader's error names the file already
+        print(f'  failed: {r["recording"]}: '
+              f'{str(r["error"]).removeprefix(str(r["recording"]) + ": ")}')
     for t in trends:
         if t['flagged']:
             print(f'  trend: valve {t["valve"]}: {t["metric"]} {t["first"]:.4g} -> '

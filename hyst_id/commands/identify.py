@@ -26,8 +26,10 @@ from hyst_id.commands.common import (
     load_recording,
     make_settings,
     make_spec,
+    prepare_outputs,
     progress_bar,
 )
+from hyst_id.errors import ConfigError
 from hyst_id.identification import identify
 
 __all__ = ['add_arguments', 'run']
@@ -54,8 +56,13 @@ def run(args: argparse.Namespace) -> int:
     from hyst_id.identification.model_choice import format_choice
     from hyst_id.identification.report import format_table, plot_identification, write_json
 
+    from hyst_id.models.registry import FAMILIES
+    if args.model != 'auto' and args.model not in FAMILIES:
+        raise ConfigError(f'--model {args.model!r}: not a hysteresis family; known: '
+                          f'{sorted(FAMILIES)} or auto')
     rec = load_recording(args)
     settings = make_settings(args)
+    prepare_outputs(args, plot_is_folder=True)
     print(f'{rec.source}: {rec.n_samples} samples over {rec.duration_s:.1f} s, '
           f'channel {rec.channel}', file=sys.stderr)
     choice = None
@@ -77,21 +84,27 @@ def run(args: argparse.Namespace) -> int:
         print()
         print(format_choice(choice))
     if args.json:
-        write_json(ident, args.json, extra=None if choice is None
-                   else {'model_choice': choice.to_dict()})
+        try:
+            write_json(ident, args.json, extra=None if choice is None
+                       else {'model_choice': choice.to_dict()})
+        except OSError as exc:
+            raise ConfigError(f'cannot write {args.json}: {exc.strerror}') from None
         print(f'wrote {args.json}', file=sys.stderr)
     if args.plot:
         for path in plot_identification(ident, rec, args.plot):
             print(f'wrote {path}', file=sys.stderr)
     if args.params_out:
-        from hyst_id.compensation.params_file import write_compensator_params
-        write_compensator_params(ident, args.params_out)
-        print(f'wrote {args.params_out}', file=sys.stderr)
+        from hyst_id.compensation.params_file import command_limits_for, write_compensator_params
+        limits = command_limits_for(rec.command)
+        write_compensator_params(ident, args.params_out, command_limits=limits)
+        said = '' if limits is None else (
+            f" (with min_command {limits[0]:g}, max_command {limits[1]:g}: the recording's "
+            "commands leave the node's default 4-20)")
+        print(f'wrote {args.params_out}{said}', file=sys.stderr)
     return 0
 
 
 def _choose(args: argparse.Namespace, rec, settings):
-    from hyst_id.errors import ConfigError
     from hyst_id.identification.model_choice import AUTO_FAMILIES, choose_family
     if args.domains != 'auto':
         raise ConfigError("--model auto derives each family's domains from the data; "

@@ -61,8 +61,29 @@ from hyst_id.io.params_file import read_yaml
 from hyst_id.models.backlash import BACKLASH_NAMES
 from hyst_id.models.registry import DEFAULT_FAMILY, FAMILIES, get_family
 
-__all__ = ['COMPENSATOR_NAMES', 'ALL_MODEL_NAMES', 'compensator_names', 'compensator_values',
-           'read_compensator_params', 'write_compensator_params']
+__all__ = ['COMPENSATOR_NAMES', 'ALL_MODEL_NAMES', 'NODE_COMMAND_LIMITS', 'command_limits_for',
+           'compensator_names', 'compensator_values', 'read_compensator_params',
+           'write_compensator_params']
+
+#: The compensator node's default ``min_command`` / ``max_command`` (the paper's 4-20 mA).
+NODE_COMMAND_LIMITS = (4.0, 20.0)
+
+
+def command_limits_for(command: Any) -> tuple[float, float] | None:
+    """Command limits for a params file: the recording's range when it leaves the node's defaults.
+
+    None when every command of the recording lies within
+    :data:`NODE_COMMAND_LIMITS` (the defaults fit, nothing is written);
+    else the recording's lowest and highest command, the range the set was
+    identified on (an actuator driven in volts or mm, not mA, would otherwise
+    have its commands clamped to 4-20).
+    """
+    import numpy as np
+    arr = np.asarray(command, dtype=float)
+    lo, hi = float(np.min(arr)), float(np.max(arr))
+    if NODE_COMMAND_LIMITS[0] <= lo and hi <= NODE_COMMAND_LIMITS[1]:
+        return None
+    return lo, hi
 
 
 def compensator_names(family: str | None = None) -> tuple[str, ...]:
@@ -163,7 +184,8 @@ def _augment_values(*sources: Any) -> dict[str, Any]:
 
 
 def write_compensator_params(identification_or_dict: Any, path: str | Path,
-                             node_name: str = '/**') -> Path:
+                             node_name: str = '/**',
+                             command_limits: tuple[float, float] | None = None) -> Path:
     """Write a ROS 2 params file for the compensator node.
 
     Parameters
@@ -175,6 +197,9 @@ def write_compensator_params(identification_or_dict: Any, path: str | Path,
     node_name : str
         Node name the section is keyed by: ``/**`` (default) for any node in
         any namespace, ``/**/compensator`` for nodes of that name only.
+    command_limits : (float, float), optional
+        Written as the node's ``min_command`` and ``max_command``
+        (:func:`command_limits_for`); None: the node's defaults hold.
 
     Returns
     -------
@@ -197,6 +222,12 @@ def write_compensator_params(identification_or_dict: Any, path: str | Path,
              f'    family: {values["family"]}']
     for name in compensator_names(values['family']) + ('output_sign', 'er_percent'):
         lines.append(f'    {name}: {_yaml_float(values[name])}')
+    if command_limits is not None:
+        lo, hi = (float(x) for x in command_limits)
+        if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
+            raise ConfigError(f'command limits need finite min < max, got {command_limits}')
+        lines += ["    # the recording's command range (the node's default is 4-20)",
+                  f'    min_command: {_yaml_float(lo)}', f'    max_command: {_yaml_float(hi)}']
     aug = {k[len(AUGMENT_PREFIX):]: v for k, v in values.items() if k.startswith(AUGMENT_PREFIX)}
     if aug:
         lines.append('    augment:')

@@ -378,6 +378,10 @@ def summary(cv: dict) -> str:
             if extra else '')
     tail += (f'; {unswept} samples of the first block before the command swept the range '
              'not judged' if unswept else '')
-    return (f"blocked cross-validation ({cv['blocks']} time blocks, each predicted by a refit "
-            f"on the others): better in {cv['better']}, worse in {cv['worse']} "
-            f"(|z| > {cv['z_min']:g}); %e_r after / before per block {ratios}{tail}")
+    n_all = len(cv['er_a_percent'])
+    blocks = (f"{cv['blocks']} time blocks" if n_all == cv['blocks'] else
+              f"{n_all} time blocks, {cv['blocks']} judged")
+    return (f'blocked cross-validation ({blocks}, each predicted by a refit on the others): '
+            f"better in {cv['better']}, worse in {cv['worse']} (|z| > {cv['z_min']:g}); %e_r "
+            f"after / before per block {ratios}{' (-: not judged)' if '-' in ratios else ''}"
+            f'{tail}')

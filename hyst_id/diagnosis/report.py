@@ -253,7 +253,10 @@ def format_diagnosis(d: Any) -> str:
         lines += [f'{head}: {f.mechanism} - {f.title}', f'    {f.explanation}',
                   f'    placed: {f.placement}', '    fitted block:']
         lines += _params_lines(f.params)
-        lines.append(f'    held-out %e_r {_fmt(f.er_holdout_before_percent)} -> '
+        judged = d.extra.get('judged_holdout') or {}
+        where = ('' if judged.get('n_samples', 0) >= judged.get('n_holdout', 0) else
+                 ' (all held-out samples; the judged ones decide, see the table)')
+        lines.append(f'    held-out %e_r{where} {_fmt(f.er_holdout_before_percent)} -> '
                      f'{_fmt(f.er_holdout_after_percent)} ({-gain:+.0f} %); training '
                      f'{_fmt(f.er_train_before_percent)} -> {_fmt(f.er_train_after_percent)}; '
                      f'delta BIC {f.delta_bic:.0f}, held-out z {f.holdout_z:.1f}')
@@ -284,8 +287,12 @@ def format_diagnosis(d: Any) -> str:
                                                'still structured: ' + '; '.join(
                                                    fl.summary(unit)[1:3])))
     withdrawn = set(d.extra.get('withdrawn', ()))
+    judged = d.extra.get('judged_holdout') or {}
+    part = ('' if judged.get('n_samples', 0) >= judged.get('n_holdout', 0) else
+            f"  (held-out %e_r over all {judged['n_holdout']} held-out samples; gain, share "
+            f"and z over the {judged['n_samples']} judged ones)")
     for r in d.rounds:
-        lines += ['', f'mechanisms tested (round {r["round"]}):',
+        lines += ['', f'mechanisms tested (round {r["round"]}):{part}',
                   f'  {"mechanism":22s}{"held-out %e_r":>14s}{"gain":>8s}{"share":>7s}'
                   f'{"dBIC":>9s}{"z":>9s}  status']
         for c in sorted(r['candidates'], key=lambda c: c['er_holdout_percent']):

@@ -57,6 +57,10 @@ class FleetOptions:
     diagnose: bool = False
     #: A :class:`~hyst_id.io.topics.TopicConfig` or mapping of topic keys (bags), or None.
     topics: Any = None
+    #: CSV columns (time, command, measurement; names or 0-based indices), None: the default.
+    columns: tuple | None = None
+    #: Factor from the CSV time column to seconds, None: 1.
+    time_scale: float | None = None
 
 
 def find_recordings(inputs: Iterable[str]) -> list[Path]:
@@ -116,7 +120,8 @@ def fleet_task(path: str, options: FleetOptions) -> dict:
         from hyst_id.identification.config import make_settings, make_spec
         from hyst_id.io.readers import read_recording
 
-        rec = read_recording(path, options.channel, topics=options.topics or None)
+        rec = read_recording(path, options.channel, topics=options.topics or None,
+                             columns=options.columns, time_scale=options.time_scale)
         spec = make_spec(rec, 'auto', family=options.model)
         settings = make_settings(seeds=options.seeds, generations=options.generations,
                                  workers=1)

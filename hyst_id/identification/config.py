@@ -47,13 +47,19 @@ def make_settings(*, seeds: int = 10, seed_offset: int = 0, pop_size: int = 10,
     ------
     ConfigError
         Fewer than one seed or generation, a population below two, negative restarts,
-        global evaluations, runs or hops, or search samples.
+        global evaluations, runs or hops, search samples or workers, an %e_r bound <= 0.
     """
     if seeds < 1 or pop_size < 2 or generations < 1 or restarts < 0 or global_evals < 0 \
             or global_runs < 0 or hops < 0 or search_samples < 0:
         raise ConfigError('need seeds >= 1, pop size >= 2, generations >= 1, restarts >= 0, '
                           'global evaluations and runs >= 0, hops >= 0 and search samples '
                           '>= 0')
+    if seed_offset < 0:
+        raise ConfigError(f'the first seed must be >= 0, got {seed_offset}')
+    if workers < 0:
+        raise ConfigError(f'workers must be >= 0 (0: one per core), got {workers}')
+    if er_bound_percent is not None and not er_bound_percent > 0.0:
+        raise ConfigError(f'the %e_r bound must be > 0 (or none), got {er_bound_percent}')
     return IdentifySettings(
         pop_size=int(pop_size), maxiter=int(generations), c=float(c), xi=float(xi),
         seeds=tuple(range(int(seed_offset), int(seed_offset) + int(seeds))),

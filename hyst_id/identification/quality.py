@@ -167,7 +167,7 @@ def fit_warnings(ident: Identification) -> list[str]:
     er = np.array([r.er_percent for r in ident.runs])
     off = int(np.sum(er > CONVERGED_FACTOR * er.min()))
     if off:
-        out.append(f'{off} of {len(er)} seeds ended more than '
+        out.append(f'{off} of {len(er)} runs (seeds and later runs) ended more than '
                    f'{100 * (CONVERGED_FACTOR - 1):.0f} % above the best %e_r (other local '
                    'optima): the best run is reported; the mean over seeds mixes optima')
     return out

@@ -51,7 +51,10 @@ def format_table(ident: Identification, truth: dict | None = None) -> str:
     if ident.channel != 'position':
         convention += f', sensor input held {ident.hold} its sample'
     units = param_units(ident.family)
-    lines = [f'channel: {ident.channel}   H family: {ident.family}   seeds: {len(ident.runs)}   '
+    n_seeds = sum(r.seed >= 0 for r in ident.runs)     # the others: hopping, global phase
+    runs = f'seeds: {n_seeds}' + (f' (+{len(ident.runs) - n_seeds} later run(s))'
+                                  if len(ident.runs) > n_seeds else '')
+    lines = [f'channel: {ident.channel}   H family: {ident.family}   {runs}   '
              f'domains: {ident.domain_source}   {convention}', head, '-' * len(head)]
     for i, name in enumerate(ident.names):
         row = (f'{name:8s} {units[name]:8s} {ident.params_mean[name]:11.4f} '
@@ -66,8 +69,10 @@ def format_table(ident: Identification, truth: dict | None = None) -> str:
         f'%e_r best run        {ident.er_percent:8.3f}   '
         f'({ident.er_percent / floor:.2f} x noise floor)' if floor > 0 else
         f'%e_r best run        {ident.er_percent:8.3f}',
-        f'%e_r mean params     {ident.er_mean_params_percent:8.3f}',
-        f'%e_r over seeds      median {np.median(er):.3f}  worst {er.max():.3f}',
+        f'%e_r mean params     {ident.er_mean_params_percent:8.3f}'
+        if np.isfinite(ident.er_mean_params_percent) else
+        '%e_r mean params          n/a  (the mean of the runs is not a valid loop)',
+        f'%e_r over runs       median {np.median(er):.3f}  worst {er.max():.3f}',
         f'noise floor %e_r     {floor:8.3f}',
     ]
     lines += [f'warning: {w}' for w in ident.warnings]

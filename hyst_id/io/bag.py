@@ -53,6 +53,7 @@ from dataclasses import dataclass, field
 import functools
 import os
 from pathlib import Path
+import struct
 from typing import Any, TYPE_CHECKING
 import zlib
 
@@ -102,8 +103,11 @@ DEFAULT_CHUNK_SPAN_S = 1.0
 #: Stamp of ``t_s = 0`` in bags made from a recording: 2026-01-01T00:00:00Z.
 DEFAULT_START_NS = 1_767_225_600 * 10**9
 
+#: What a damaged bag raises inside rosbags (a corrupt size field: OverflowError,
+#: MemoryError; a short record: struct.error), found by flipping bytes of a bag.
 _READ_ERRORS = (AnyReaderError, ReaderError, SerdeError, TypesysError, OSError, ValueError,
-                TypeError, KeyError, IndexError, EOFError, AssertionError, zlib.error)
+                TypeError, KeyError, IndexError, EOFError, AssertionError, zlib.error,
+                OverflowError, MemoryError, struct.error)
 
 
 def default_typestore() -> Typestore:

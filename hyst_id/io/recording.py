@@ -52,6 +52,10 @@ MAX_ABS_VALUE = 1e15
 #: more than one run (or lost data) and is refused.
 MAX_GAP_FACTOR = 1000.0
 
+#: A command whose range is below this share of its largest magnitude excites
+#: nothing (a float32 reading resolves about 6e-8 of its value).
+MIN_RELATIVE_COMMAND_RANGE = 1e-6
+
 
 @dataclass(frozen=True)
 class Recording:
@@ -200,6 +204,12 @@ def validate_recording(rec: Recording, *, min_samples: int = MIN_SAMPLES,
             'split the recording or pass a larger max_gap_factor')
     if np.ptp(arrays['command']) <= 0.0:
         raise NoExcitationError('command is constant: nothing excites the hysteresis loop')
+    level = float(np.max(np.abs(arrays['command'])))
+    if np.ptp(arrays['command']) <= MIN_RELATIVE_COMMAND_RANGE * level:
+        raise NoExcitationError(
+            f'command varies by {np.ptp(arrays["command"]):.3g} at magnitudes up to '
+            f'{level:.6g}, less than {MIN_RELATIVE_COMMAND_RANGE:g} of them (finer than a '
+            'float32 reading resolves): nothing excites the hysteresis loop')
     reversals = count_reversals(arrays['command'])
     if reversals < min_reversals:
         raise NoExcitationError(

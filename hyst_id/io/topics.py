@@ -33,7 +33,7 @@ from hyst_id.io.params_file import read_yaml
 from hyst_id.io.recording import CHANNELS
 
 __all__ = ['NamedIndex', 'NODE_STREAM_KEYS', 'TOPIC_FILE_KEYS', 'TopicConfig', 'get_field',
-           'load_topic_config', 'parse_field_path', 'value_field']
+           'load_topic_config', 'node_parameters_in', 'parse_field_path', 'value_field']
 
 #: Per channel: topic, message type, field path, unit.
 _COMMAND_DEFAULTS = ('/hyst_id/command', 'std_msgs/msg/Float64', 'data', 'mA')
@@ -204,6 +204,22 @@ class TopicConfig:
         return cls(**values)
 
 
+def node_parameters_in(yaml_path: str | Path) -> list[str]:
+    """The keys of a params file's node sections that are not topics or fields (sorted).
+
+    What a node reads (GAASS settings, QoS, ...) and a recording's reader does
+    not: the CLI names them so that a user does not take them as applied.
+    """
+    doc = read_yaml(Path(yaml_path))
+    keys = set()
+    for value in (doc.values() if isinstance(doc, dict) else ()):
+        params = value.get('ros__parameters') if isinstance(value, dict) else None
+        if isinstance(params, dict):
+            keys |= {str(k) for k in params if k != 'topics' and not str(k).startswith(
+                'topics.') and k not in _KEYS and k not in NODE_STREAM_KEYS}
+    return sorted(keys)
+
+
 def load_topic_config(yaml_path: str | Path, channel: str, *,
                       node: str | None = None) -> TopicConfig:
     """Read the topic configuration of ``channel`` from a params YAML file.
@@ -237,6 +253,12 @@ def load_topic_config(yaml_path: str | Path, channel: str, *,
                               f'{where}; known: {sorted(_KEYS)}')
         merged.update({k: v for k, v in section.items() if k in _KEYS})
 
+    stray = [k for k, v in doc.items()
+             if k != 'topics' and not (isinstance(v, dict) and 'ros__parameters' in v)]
+    if stray:
+        raise ConfigError(f'{yaml_path}: unknown top-level key(s) {sorted(map(str, stray))}: '
+                          'a params file holds a topics: mapping or ROS node sections '
+                          '(<node>: ros__parameters:)')
     if 'topics' in doc:
         take('topics', doc['topics'], True)
     for key, value in doc.items():

@@ -59,7 +59,8 @@ from std_msgs.msg import String
 from hyst_id.compensation import CommandLimits, InverseModel
 from hyst_id.compensation.augment import AugmentedCompensator
 from hyst_id.compensation.inverse import warm_up
-from hyst_id.compensation.params_file import ALL_MODEL_NAMES, compensator_names
+from hyst_id.compensation.params_file import (ALL_MODEL_NAMES, compensator_names,
+                                              NODE_COMMAND_LIMITS)
 from hyst_id.errors import InvalidParametersError
 from hyst_id.io.recording import CHANNELS
 from hyst_id.models.registry import DEFAULT_FAMILY, FAMILIES, get_family
@@ -126,8 +127,10 @@ PARAMS = [
     Param('output_sign', 1.0, 'sign of the sensor gain (canonical calibration): -1 when the '
           'measurement falls as the actuator output rises', low=-1.0, high=1.0),
     Param('er_percent', _NAN, '%e_r (Eq. 7) of the identification; information only'),
-    Param('min_command', 4.0, 'lowest command sent', low=-1e6, high=1e6, unit='mA'),
-    Param('max_command', 20.0, 'highest command sent', low=-1e6, high=1e6, unit='mA'),
+    Param('min_command', NODE_COMMAND_LIMITS[0], 'lowest command sent', low=-1e6, high=1e6,
+          unit='mA'),
+    Param('max_command', NODE_COMMAND_LIMITS[1], 'highest command sent', low=-1e6, high=1e6,
+          unit='mA'),
     Param('max_rate_per_s', 0.0, 'largest command change per second; 0 = unlimited',
           low=0.0, high=1e9, unit='mA/s'),
     Param('initial_command', 9.0, 'command the actuator holds before the first sample',

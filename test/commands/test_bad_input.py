@@ -171,6 +171,22 @@ CASES = [
     ('negative-hops', lambda d: [str(write_csv(d / 'ok8.csv')), '--hops', '-1'], 'hops >= 0'),
     ('bad-columns-option', lambda d: [str(write_csv(d / 'ok5.csv')), '--columns', 't,command'],
      'three'),
+    ('same-column-twice', lambda d: [str(write_csv(d / 'ok9.csv')), '--columns',
+                                     't,command,command'], 'three different columns'),
+    ('near-constant-command', lambda d: [str(write_csv(d / 'nc.csv', v=3.0 + 1e-9 * np.sin(
+        2 * np.pi * T / 10)))], 'nothing excites'),
+    ('negative-er-bound', lambda d: [str(write_csv(d / 'ok10.csv')), '--er-bound', '-3'],
+     'bound must be > 0'),
+    ('unknown-model', lambda d: [str(write_csv(d / 'ok11.csv')), '--model', 'foo'], 'or auto'),
+    ('params-unknown-key', lambda d: [str(write_csv(d / 'ok12.csv')), '--params',
+                                      str(_text(d / 'p.yaml', 'seeds: 1\ngenerations: 5\n'))],
+     'unknown top-level key'),
+    ('plot-folder-is-a-file', lambda d: [str(write_csv(d / 'ok13.csv')), '--plot',
+                                         str(_touch(d / 'figs'))], 'not a folder'),
+    ('json-under-a-file', lambda d: [str(write_csv(d / 'ok14.csv')), '--json',
+                                     str(_touch(d / 'f') / 'r.json')], 'not a folder'),
+    ('params-out-is-a-folder', lambda d: [str(write_csv(d / 'ok15.csv')), '--params-out',
+                                          str(d)], 'a folder'),
 ]
 
 
@@ -228,3 +244,54 @@ def test_real_process_exit_code_and_stderr(tmp_path):
     assert proc.returncode == 2
     assert proc.stderr.strip().count('\n') == 0, proc.stderr
     assert proc.stderr.startswith('hyst-id: error:')
+
+
+def test_outputs_go_into_folders_made_for_them(tmp_path, capsys):
+    """``--plot out/ --json out/result.json`` (the README's quick start) on a fresh folder."""
+    csv = write_csv(tmp_path / 'run.csv')
+    code = main(['identify', str(csv), '--quiet', '--seeds', '1', '--generations', '5',
+                 '--workers', '1', '--hops', '0', '--plot', str(tmp_path / 'out'), '--json',
+                 str(tmp_path / 'out' / 'result.json'), '--params-out',
+                 str(tmp_path / 'sets' / 'c.yaml')])
+    assert code == 0, capsys.readouterr().err
+    assert (tmp_path / 'out' / 'result.json').is_file()
+    assert sorted(p.name for p in (tmp_path / 'out').glob('*.png'))
+    assert (tmp_path / 'sets' / 'c.yaml').is_file()
+
+
+def test_a_node_params_file_names_what_the_cli_does_not_use(tmp_path, capsys):
+    """A node's params file reads its topics; its other parameters are named, not applied."""
+    csv = write_csv(tmp_path / 'run.csv')
+    params = _text(tmp_path / 'node.yaml', '/**:\n  ros__parameters:\n    seeds: 1\n'
+                   '    generations: 5\n')
+    assert main(['identify', str(csv), '--params', str(params), '--quiet', '--seeds', '1',
+                 '--generations', '5', '--workers', '1', '--hops', '0']) == 0
+    err = capsys.readouterr().err
+    assert 'node parameters generations, seeds are not used' in err
+
+
+def test_damaged_bags_give_a_clear_error_never_an_internal_one(tmp_path):
+    """Bytes of a bag flipped, randomised or zeroed at random places: read, or a RecordingError.
+
+    Found by this kind of damage: a corrupt size field makes rosbags raise
+    OverflowError or MemoryError, a short record struct.error.
+    """
+    from hyst_id.errors import HystIdError
+    from hyst_id.io.readers import read_recording
+    bag = make_bag(tmp_path / 'good')
+    src = next(bag.glob('*.mcap')).read_bytes()
+    rng = np.random.default_rng(3)
+    outcomes = {'read': 0, 'refused': 0}
+    for k in range(60):
+        data = bytearray(src)
+        start, n = int(rng.integers(0, len(data) - 8)), int(rng.choice([1, 8, 50, 400]))
+        for i in range(start, min(len(data), start + n)):
+            data[i] = (data[i] ^ 0xFF, int(rng.integers(0, 256)), 0)[k % 3]
+        path = tmp_path / f'bad{k}.mcap'
+        path.write_bytes(bytes(data))
+        try:
+            read_recording(str(path), 'position')
+            outcomes['read'] += 1
+        except HystIdError:
+            outcomes['refused'] += 1
+    assert outcomes['refused'] > 0, outcomes

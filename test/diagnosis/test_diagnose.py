@@ -343,6 +343,20 @@ def test_cli_errors_are_one_line(tmp_path, capsys):
     assert 'supply_decay cannot act on the position channel' in err[-1], err
     assert main(['diagnose', str(csv), '--hops', '-1', '--quiet']) == 2
     assert '--hops must be at least 0' in capsys.readouterr().err
+    # an empty name is not "all of them", an output without its input is not ignored
+    for bad in ('', 'dead_time,,'):
+        assert main(['diagnose', str(csv), '--mechanisms', bad, '--quiet']) == 2
+        assert 'an empty name' in capsys.readouterr().err
+    assert main(['diagnose', str(csv), '--sim-out', str(tmp_path / 's.yaml'), '--quiet']) == 2
+    assert 'it needs --sim' in capsys.readouterr().err
+    assert main(['diagnose', str(csv), '--workers', '-2', '--quiet']) == 2
+    assert '--workers must be >= 0' in capsys.readouterr().err
+    # an output that cannot be written is refused before the diagnosis runs
+    (tmp_path / 'afile').write_text('')
+    assert main(['diagnose', str(csv), '--json', str(tmp_path / 'afile' / 'd.json'),
+                 '--quiet']) == 2
+    assert 'is a file, not a folder' in capsys.readouterr().err
+    assert not list(tmp_path.glob('*.json')) and not list(tmp_path.glob('*.png'))
 
 
 @pytest.mark.parametrize('flag', ['--global-runs', '--restarts', '--search-samples',

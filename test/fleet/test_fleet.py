@@ -121,6 +121,29 @@ def test_cli_fleet_writes_table_and_trends(fleet_dir, tmp_path, capsys):
     assert any(t['flagged'] for t in trends)
 
 
+def test_cli_fleet_reads_headerless_csv_columns_and_refuses_bad_options(tmp_path, capsys):
+    """``--columns``/``--time-scale`` as identify's (the shared cylinder files' layout)."""
+    rec = _recording(0.15, 3)
+    folder = tmp_path / 'in'
+    folder.mkdir()
+    np.savetxt(folder / 'run.csv', np.c_[rec.t_s * 1000.0, rec.measurement, rec.command],
+               delimiter='\t', fmt='%.9g')
+    out = tmp_path / 'out'
+    args = ['fleet', str(folder), '--out', str(out), '--seeds', '1', '--generations', '40',
+            '--workers', '1', '--no-progress']
+    assert cli_main(args + ['--columns', '0,2,1', '--time-scale', '0.001']) == 0
+    doc = json.loads(next((out / 'recordings').glob('*.json')).read_text())
+    assert doc['status'] == 'ok' and doc['duration_s'] == pytest.approx(rec.duration_s)
+    capsys.readouterr()
+    for extra, needle in ((['--seeds', '0'], 'seeds >= 1'), (['--workers', '-1'], 'workers'),
+                          (['--columns', '0,1,1'], 'three different columns'),
+                          (['--time-scale', '0'], '--time-scale must be'),
+                          (['--out', str(folder / 'run.csv')], 'a file, not a folder')):
+        assert cli_main(args + extra) == 2, extra
+        err = capsys.readouterr().err
+        assert needle in err and 'internal error' not in err, err
+
+
 @pytest.mark.slow
 def test_fleet_on_a_local_dask_cluster(fleet_dir, tmp_path):
     pytest.importorskip('distributed')

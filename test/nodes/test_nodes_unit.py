@@ -33,6 +33,7 @@ from rclpy.parameter import Parameter  # noqa: E402
 from std_msgs.msg import Float64, String  # noqa: E402
 
 from hyst_id.compensation.params_file import (  # noqa: E402
+    command_limits_for,
     COMPENSATOR_NAMES,
     read_compensator_params,
     write_compensator_params,
@@ -180,6 +181,29 @@ def test_bad_params_file_is_a_one_line_config_error(ros_domain, tmp_path):
             assert '\n' not in str(info.value)
         finally:
             context.try_shutdown()
+
+
+def test_a_set_of_an_actuator_outside_4_20_brings_its_command_limits(ros_domain, tmp_path):
+    """A set identified in volts (``--params-out``): the node clamps to its range, not 4-20."""
+    assert command_limits_for(np.linspace(7.0, 11.0, 5)) is None      # the defaults fit
+    limits = command_limits_for(np.array([-150.0, 0.0, 150.0]))
+    assert limits == (-150.0, 150.0)
+    path = write_compensator_params({'channel': 'position', 'params': dict(PAPER)},
+                                    tmp_path / 'c.yaml', command_limits=limits)
+    with pytest.raises(ConfigError, match='finite min < max'):
+        write_compensator_params({'params': dict(PAPER)}, tmp_path / 'x.yaml',
+                                 command_limits=(1.0, 1.0))
+    assert read_compensator_params(path)['m_l'] == PAPER['m_l']
+    context = rclpy.Context()
+    rclpy.init(args=['--ros-args', '--params-file', str(path)], context=context)
+    try:
+        comp = Compensator(context=context)
+        try:
+            assert (comp.p('min_command'), comp.p('max_command')) == (-150.0, 150.0)
+        finally:
+            comp.destroy_node()
+    finally:
+        context.try_shutdown()
 
 
 def test_node_main_reports_bad_input_in_one_line(ros_domain, tmp_path, capfd):
