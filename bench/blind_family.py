@@ -96,8 +96,12 @@ def _logu(rng: np.random.Generator, lo: float, hi: float) -> float:
     return float(np.exp(rng.uniform(np.log(lo), np.log(hi))))
 
 
-def draw(index: int) -> dict:
-    """Recording ``index``: command, measurement, the effects and their magnitudes."""
+def draw(index: int, only: frozenset | None = None) -> dict:
+    """Recording ``index``: command, measurement, the effects and their magnitudes.
+
+    ``only``: apply only these of its effects (the others are drawn, so that
+    everything else is the same, but left out): what one effect alone costs.
+    """
     rng = np.random.default_rng([index, 14])
     channel = ('position', 'pressure')[index % 2]
     n_eff = int(rng.choice([0, 1, 2], p=[0.25, 0.5, 0.25]))
@@ -105,6 +109,7 @@ def draw(index: int) -> dict:
     if index >= FRICTION_FROM:
         effects = ['friction'] + effects[:1]
     effects = sorted(effects)
+    on = {e for e in effects if only is None or e in only}
     dt = float(rng.choice([0.01, 0.02, 0.05, 0.1]))
     t = np.arange(N_SAMPLES) * dt
     kind = (*EXCITATIONS, 'moves and holds')[int(rng.integers(0, len(EXCITATIONS) + 1))]
@@ -119,44 +124,53 @@ def draw(index: int) -> dict:
     if 'dead_time' in effects:
         d = int(round(_logu(rng, 1.0, 10.0)))
         mags['dead_time'] = d * dt
+    if 'dead_time' in on:
         vv = np.concatenate([np.full(d, v[0]), v[:-d]])
     x = reference_simulate('position', p, t, vv)
     span = float(np.ptp(x))
     if 'saturation' in effects:
         cut = _logu(rng, 0.02, 0.25)
         mags['saturation'] = cut
+    if 'saturation' in on:
         x = np.minimum(x, float(np.max(x)) - cut * span)
     if 'static_nonlinearity' in effects:
         c = _logu(rng, 0.01, 0.2)
         mags['static_nonlinearity'] = c
+    if 'static_nonlinearity' in on:
         z = (x - float(np.min(x))) / span
         x = x + c * span * z ** 2
     if 'friction' in effects:         # a force with the motion: 1-20 % of the span
         frng = np.random.default_rng([index, 14, 1])
         force, length = _logu(frng, 0.01, 0.2), _logu(frng, 0.005, 0.1)
         mags['friction'] = force
+    if 'friction' in on:
         x = x + force * span * euler_dahl(x, length * span)
     if 'actuator_dynamics' in effects:
         zeta, wdt = rng.uniform(0.1, 0.5), _logu(rng, 0.05, 0.5)
         mags['actuator_dynamics'] = wdt
+    if 'actuator_dynamics' in on:
         x = second_order_sensor(t, x, zeta, wdt / dt)
     y = first_order_sensor(t, x, p['tau_s']) if channel == 'pressure' else x
     span = float(np.ptp(y))
     if 'sensor_lag' in effects:
         tau = _logu(rng, 0.5, 20.0) * dt
         mags['sensor_lag'] = tau
+    if 'sensor_lag' in on:
         y = first_order_sensor(t, y, tau)
     if 'creep' in effects:
         share, tau_c = _logu(rng, 0.02, 0.2), rng.uniform(0.02, 0.2) * t[-1]
         mags['creep'] = share
+    if 'creep' in on:
         y = (1.0 - share) * y + share * first_order_sensor(t, y, tau_c)
     if 'gain_drift' in effects:       # the sensitivity, about the sensor's zero
         g = _logu(rng, 0.005, 0.15)
         mags['gain_drift'] = g
+    if 'gain_drift' in on:
         y = y * (1.0 + g * t / t[-1])
     if 'offset_drift' in effects:
         r = _logu(rng, 0.002, 0.1)
         mags['offset_drift'] = r
+    if 'offset_drift' in on:
         y = y + r * span * t / t[-1]
     sigma = rng.uniform(0.002, 0.01) * span
     y = y + rng.normal(0.0, sigma, y.size)
@@ -164,7 +178,8 @@ def draw(index: int) -> dict:
     k = float(np.exp(rng.uniform(np.log(0.1), np.log(100.0))))
     zero = rng.uniform(-10, 10) * k       # the reading of y = 0 (gain_drift's pivot)
     return {'index': index, 'channel': channel, 'excitation': kind, 'dt_s': dt,
-            'effects': effects, 'magnitudes': mags, 't': t, 'command': a * v + b,
+            'effects': sorted(on),
+            'magnitudes': {e: mags[e] for e in sorted(on)}, 't': t, 'command': a * v + b,
             'measurement': k * y + zero, 'sensor_zero': zero,
             'noise_percent_of_span': 100.0 * sigma / span,
             # the reference chain's parameters, for the command before its affine map
@@ -271,6 +286,9 @@ def summary(rows: list[dict], how: str = 'one worker each') -> str:
         lo = [r for r in has if r['cost'] <= 3.0]
         lines.append(f'| {e} | {len(has)} | {len(hi)} | {sum(e in r["found"] for r in hi)} | '
                      f'{sum(e in r["found"] for r in lo)}/{len(lo)} |')
+    from blind_effect_costs import alone_figures    # its costs, when written
+    alone = alone_figures(rows, (*EFFECTS, 'friction'))
+    lines += ['', alone] if alone else []
     lines += ['', blocked_tally(rows)]
     wrong = [r for r in big if not _right(r)]
     lines += ['', 'Misses where the effects cost > 3 x the floor:', '']
@@ -488,7 +506,11 @@ def main() -> int:
     ap.add_argument('--against', metavar='NEW_JSON',
                     help='with --compare: compare with NEW_JSON instead of the documented run')
     ap.add_argument('--from-json', action='store_true',
-                    help='only reprint the tables from docs/diagnosis_blind.json')
+                    help='only reprint the tables from docs/diagnosis_blind.json (with '
+                    '--diagnose-workers K: of a run one at a time in K processes)')
+    ap.add_argument('--write-md', action='store_true',
+                    help='with --from-json: write them to docs/diagnosis_blind.md too (after '
+                    'bench/blind_effect_costs.py added its figures)')
     ap.add_argument('--so-far', action='store_true',
                     help='only print the tables of the rows a run in parts on this code has '
                          'finished (docs/diagnosis_blind.partial.jsonl)')
@@ -520,7 +542,12 @@ def main() -> int:
         print(time_ratio(before, now, args.indices))
         return 0
     if args.from_json:
-        print(summary(json.loads((ROOT / 'docs' / 'diagnosis_blind.json').read_text())))
+        k = args.diagnose_workers
+        rows = json.loads((ROOT / 'docs' / 'diagnosis_blind.json').read_text())
+        text = summary(rows, 'one worker each' if k <= 1 else f'one at a time in {k} processes')
+        print(text)
+        if args.write_md:
+            _write_md(text, len(rows), k)
         return 0
     if args.so_far:
         rows = rows_so_far()
@@ -563,13 +590,17 @@ def main() -> int:
               + time_ratio(documented, rows, args.indices))
     if full:
         (ROOT / 'docs' / 'diagnosis_blind.json').write_text(_rows_json(rows))
-        (ROOT / 'docs' / 'diagnosis_blind.md').write_text(
-            '# Blind diagnosis on the reference family (issue 14)\n\nWritten by '
-            f'`python bench/blind_family.py --n {args.n}'
-            + (f' --diagnose-workers {k}' if k > 1 else '') + '`; see the docstring of the script '
-            'for the family.\n\n' + text + '\n')
+        _write_md(text, args.n, k)
         PARTIAL.unlink(missing_ok=True)
     return 0
+
+
+def _write_md(text: str, n: int, k: int) -> None:
+    (ROOT / 'docs' / 'diagnosis_blind.md').write_text(
+        '# Blind diagnosis on the reference family (issue 14)\n\nWritten by '
+        f'`python bench/blind_family.py --n {n}' + (f' --diagnose-workers {k}' if k > 1 else '')
+        + '` (the tables again from its rows: `--from-json --diagnose-workers 2 --write-md`); '
+        'see the docstring of the script for the family.\n\n' + text + '\n')
 
 
 if __name__ == '__main__':

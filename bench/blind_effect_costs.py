@@ -1,0 +1,138 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""What each effect of the blind family's two-effect recordings costs alone (issue 14, 5).
+
+``bench/blind_family.py`` measures a recording's cost (the baseline's judged
+held-out %e_r over the noise floor) with all its effects in. Issue 14's
+target is per effect ("named right where the effect costs more than 3 x the
+floor"), and in a recording with two effects one of them can cost little: a
+second effect that alone stays at the floor cannot be told from the noise
+once the first is modelled. This script draws each two-effect recording
+again with one of its effects only (``blind_family.draw(index, only=...)``:
+the same command, chain, noise and magnitudes, the other effect left out)
+and runs the diagnosis's baseline on it (``DiagnoseSettings(max_mechanisms=0)``:
+the same split, identification and judged rows as the full diagnosis). As a
+check it does the same for ``--check`` one-effect recordings, whose cost the
+blind run already has: the two must agree.
+
+Writes ``docs/data/blind_effect_costs.json`` (``{index: {effect: cost}}``),
+which ``blind_family.py`` reads for its per-effect figures.
+
+Usage (repository root, about 10 minutes on 2 cores)::
+
+    python bench/blind_effect_costs.py [--n 180] [--workers 2] [--check 4]
+"""
+
+from __future__ import annotations
+
+import argparse
+from concurrent.futures import as_completed, ProcessPoolExecutor
+import json
+from pathlib import Path
+import sys
+import time
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from blind_family import draw, ROOT  # noqa: E402, I100
+
+OUT = ROOT / 'docs' / 'data' / 'blind_effect_costs.json'
+
+
+def alone_figures(rows: list[dict], effects: tuple[str, ...]) -> str:
+    """Issue 14's named-right figure per effect, each effect costed alone; '' without costs.
+
+    One-effect recordings keep the blind run's cost; two-effect ones take
+    this script's (``OUT``). Named = among the findings (those blocked
+    cross-validation confirmed, as in the blind run's tables).
+    """
+    try:
+        costs = json.loads(OUT.read_text())
+    except (OSError, ValueError):
+        return ''
+    two = [r for r in rows if len(r['effects']) == 2]
+    if any(str(r['index']) not in costs for r in two):
+        return ''
+
+    def alone(r: dict, e: str) -> float:
+        return r['cost'] if len(r['effects']) == 1 else costs[str(r['index'])][e]
+
+    pairs = [(r, e) for r in rows for e in r['effects']]
+    big = [(r, e) for r, e in pairs if alone(r, e) > 3.0]
+    recs = [r for r in rows if any(alone(r, e) > 3.0 for e in r['effects'])]
+    right = [r for r in recs if set(r['found']) <= set(r['effects'])
+             and all(e in r['found'] for e in r['effects'] if alone(r, e) > 3.0)]
+    lines = ['Each effect costed alone (`python bench/blind_effect_costs.py`: the two-effect '
+             'recordings drawn again with one effect, the baseline of the diagnosis on each; '
+             f'{sum(alone(r, e) <= 3.0 for r in two for e in r["effects"])} of the '
+             f'{2 * len(two)} effects of two-effect recordings cost <= 3 x alone):', '',
+             '| figure | value |', '|---|---|',
+             '| effects that alone cost > 3 x the floor, named | '
+             f'{sum(e in r["found"] for r, e in big)}/{len(big)} |',
+             '| recordings with an effect that alone costs > 3 x: every such effect named, '
+             f'no finding that is not an effect | {len(right)}/{len(recs)} |', '',
+             '| effect | alone > 3 x | named there | alone <= 3 x | named there |',
+             '|---|---|---|---|---|']
+    for e in effects:
+        hi = [r for r, f in big if f == e]
+        lo = [r for r, f in pairs if f == e and alone(r, f) <= 3.0]
+        lines.append(f'| {e} | {len(hi)} | {sum(e in r["found"] for r in hi)} | {len(lo)} | '
+                     f'{sum(e in r["found"] for r in lo)} |')
+    return '\n'.join(lines)
+
+
+def alone_cost(index: int, effect: str) -> tuple[int, str, float]:
+    """The judged baseline held-out %e_r over the floor of ``index`` with ``effect`` only."""
+    from hyst_id.diagnosis import diagnose, DiagnoseSettings
+    from hyst_id.io.recording import Recording
+    case = draw(index, only=frozenset({effect}))
+    rec = Recording(case['t'], case['command'], case['measurement'], case['channel'],
+                    source=f'blind #{index}, {effect} only')
+    d = diagnose(rec, settings=DiagnoseSettings(workers=1, max_mechanisms=0))
+    j = d.extra['judged_holdout']
+    return index, effect, j['baseline_er_percent'] / j['noise_floor_percent']
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument('--n', type=int, default=180)
+    ap.add_argument('--workers', type=int, default=2)
+    ap.add_argument('--check', type=int, default=4,
+                    help='one-effect recordings costed again, against the blind run')
+    args = ap.parse_args()
+    blind = {r['index']: r for r in json.loads(
+        (ROOT / 'docs' / 'diagnosis_blind.json').read_text())}
+    cases = [draw(i) for i in range(args.n)]
+    tasks = [(c['index'], e) for c in cases if len(c['effects']) == 2 for e in c['effects']]
+    checks = [(c['index'], c['effects'][0]) for c in cases
+              if len(c['effects']) == 1 and c['index'] in blind][:args.check]
+    costs: dict[str, dict[str, float]] = {}
+    t0 = time.time()
+    with ProcessPoolExecutor(max_workers=args.workers) as pool:
+        futures = [pool.submit(alone_cost, i, e) for i, e in tasks + checks]
+        for k, fut in enumerate(as_completed(futures), 1):
+            i, e, cost = fut.result()
+            if (i, e) in checks:
+                print(f'check #{i} {e}: alone {cost:.3f} x, blind run {blind[i]["cost"]:.3f} x',
+                      flush=True)
+                continue
+            costs.setdefault(str(i), {})[e] = cost
+            print(f'[{k}/{len(futures)} {time.time() - t0:.0f} s] #{i} {e} alone: '
+                  f'{cost:.2f} x (with both: {blind[i]["cost"]:.2f} x)', flush=True)
+    OUT.write_text(json.dumps({k: costs[k] for k in sorted(costs, key=int)}, indent=1) + '\n')
+    print(f'wrote {OUT.relative_to(ROOT)}')
+
+
+if __name__ == '__main__':
+    main()
