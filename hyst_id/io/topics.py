@@ -204,6 +204,27 @@ class TopicConfig:
         return cls(**values)
 
 
+def _holds_node_section(value: Any) -> bool:
+    """A node section (``ros__parameters``), or a namespace holding one (``/ns: node: ...``)."""
+    return isinstance(value, dict) and ('ros__parameters' in value or any(
+        _holds_node_section(v) for v in value.values()))
+
+
+def _node_sections(doc: dict, prefix: str = '') -> list[tuple[str, str, Any]]:
+    """``(where, node name, ros__parameters)`` of every node section, namespaces walked."""
+    out = []
+    for key, value in doc.items():
+        if not isinstance(value, dict):
+            continue
+        where = f'{prefix}{key}'
+        if 'ros__parameters' in value:
+            out.append((f'{where}.ros__parameters', str(key).strip('/'),
+                        value['ros__parameters'] or {}))
+        else:
+            out += _node_sections(value, f'{where}.')
+    return out
+
+
 def node_parameters_in(yaml_path: str | Path) -> list[str]:
     """The keys of a params file's node sections that are not topics or fields (sorted).
 
@@ -211,9 +232,8 @@ def node_parameters_in(yaml_path: str | Path) -> list[str]:
     not: the CLI names them so that a user does not take them as applied.
     """
     doc = read_yaml(Path(yaml_path))
-    keys = set()
-    for value in (doc.values() if isinstance(doc, dict) else ()):
-        params = value.get('ros__parameters') if isinstance(value, dict) else None
+    keys: set[str] = set()
+    for _, _, params in _node_sections(doc if isinstance(doc, dict) else {}):
         if isinstance(params, dict):
             keys |= {str(k) for k in params if k != 'topics' and not str(k).startswith(
                 'topics.') and k not in _KEYS and k not in NODE_STREAM_KEYS}
@@ -224,18 +244,23 @@ def load_topic_config(yaml_path: str | Path, channel: str, *,
                       node: str | None = None) -> TopicConfig:
     """Read the topic configuration of ``channel`` from a params YAML file.
 
-    Accepted layouts: a top-level ``topics:`` mapping; or the ROS params-file
-    layout ``<node>: ros__parameters:`` with a ``topics:`` mapping inside or
-    the keys given flat (``command_topic``, ``<channel>_field``, ...) or
-    dotted (``topics.command_topic``). Sections are merged in file order;
-    with ``node`` only ``/**`` and that node's section count. A file without
-    any of these keys gives the defaults.
+    Accepted layouts: a top-level ``topics:`` mapping (its keys checked);
+    or the ROS params-file layout ``<node>: ros__parameters:`` (also under
+    namespaces, ``/ns: <node>: ros__parameters:``) with a ``topics:``
+    mapping inside or the keys given flat (``command_topic``,
+    ``<channel>_field``, ...) or dotted (``topics.command_topic``); a node
+    section's other keys, and topic keys only that node knows (the
+    identifier's ``identified_params_topic``, the recorder's list of topics),
+    are the node's and left alone (:func:`node_parameters_in` names them).
+    Sections are merged in file order; with ``node`` only ``/**`` and that
+    node's section count. A file with neither gives the defaults; any other
+    top-level key is refused.
 
     Raises
     ------
     ConfigError
-        Unreadable or invalid YAML, unknown keys in a ``topics:`` mapping,
-        invalid values.
+        Unreadable or invalid YAML, unknown top-level keys, unknown keys in a
+        top-level ``topics:`` mapping, invalid values.
     """
     yaml_path = Path(yaml_path)
     doc = read_yaml(yaml_path)
@@ -253,25 +278,20 @@ def load_topic_config(yaml_path: str | Path, channel: str, *,
                               f'{where}; known: {sorted(_KEYS)}')
         merged.update({k: v for k, v in section.items() if k in _KEYS})
 
-    stray = [k for k, v in doc.items()
-             if k != 'topics' and not (isinstance(v, dict) and 'ros__parameters' in v)]
+    stray = [k for k, v in doc.items() if k != 'topics' and not _holds_node_section(v)]
     if stray:
         raise ConfigError(f'{yaml_path}: unknown top-level key(s) {sorted(map(str, stray))}: '
                           'a params file holds a topics: mapping or ROS node sections '
                           '(<node>: ros__parameters:)')
     if 'topics' in doc:
         take('topics', doc['topics'], True)
-    for key, value in doc.items():
-        if not (isinstance(value, dict) and 'ros__parameters' in value):
+    for where, name, params in _node_sections(doc):
+        if node is not None and name not in ('**', node.strip('/')):
             continue
-        if node is not None and str(key).strip('/') not in ('**', node.strip('/')):
-            continue
-        params = value['ros__parameters'] or {}
-        where = f'{key}.ros__parameters'
         if not isinstance(params, dict):
             raise ConfigError(f'{yaml_path}: {where} must be a mapping')
-        if 'topics' in params:
-            take(f'{where}.topics', params['topics'], True)
+        if isinstance(params.get('topics'), dict):
+            take(f'{where}.topics', params['topics'], False)
         take(where, {k.removeprefix('topics.'): v for k, v in params.items()}, False)
     try:
         return TopicConfig.for_channel(channel, merged)

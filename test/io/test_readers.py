@@ -30,7 +30,8 @@ from hyst_id.io.csv_reader import read_csv
 from hyst_id.io.mcap_reader import read_mcap
 from hyst_id.io.readers import read_recording
 from hyst_id.io.recording import Recording
-from hyst_id.io.topics import load_topic_config, parse_field_path, TopicConfig
+from hyst_id.io.topics import (load_topic_config, node_parameters_in, parse_field_path,
+                               TopicConfig)
 
 __all__: list[str] = []
 
@@ -507,6 +508,23 @@ def test_topic_config_layouts(tmp_path: Path) -> None:
     assert load_topic_config(flat, 'pressure', node='other') == \
         TopicConfig.for_channel('pressure')
     assert parse_field_path('a.b[2][3].c') == ('a', 'b', 2, 3, 'c')
+
+
+@pytest.mark.parametrize('path', sorted((REPO / 'params').glob('*.yaml')), ids=lambda p: p.name)
+def test_every_shipped_params_file_gives_its_topics_to_the_cli(path: Path) -> None:
+    """``--params`` takes any node's file: its own stream keys and settings are left to it."""
+    assert isinstance(load_topic_config(path, 'position'), TopicConfig)
+
+
+def test_topic_config_namespaces_and_strays(tmp_path: Path) -> None:
+    nested = _write(tmp_path / 'n.yaml', '/valve1:\n  identifier:\n    ros__parameters:\n'
+                    '      seeds: 2\n      command_topic: /v1/cmd\n      topics:\n'
+                    '        identified_params_topic: /x\n')
+    assert load_topic_config(nested, 'position').command_topic == '/v1/cmd'
+    assert node_parameters_in(nested) == ['seeds']
+    stray = _write(tmp_path / 's.yaml', 'seeds: 1\ntopics:\n  command_topic: /c\n')
+    assert "unknown top-level key(s) ['seeds']" in _raises(ConfigError, load_topic_config,
+                                                           stray, 'flow')
 
 
 def test_topic_config_errors(tmp_path: Path) -> None:
