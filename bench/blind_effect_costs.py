@@ -30,7 +30,7 @@ blind run already has: the two must agree.
 Writes ``docs/data/blind_effect_costs.json`` (``{index: {effect: cost}}``),
 which ``blind_family.py`` reads for its per-effect figures.
 
-Usage (repository root, about 10 minutes on 2 cores)::
+Usage (repository root, about 15 minutes on 2 cores)::
 
     python bench/blind_effect_costs.py [--n 180] [--workers 2] [--check 4]
 """
@@ -104,7 +104,7 @@ def alone_cost(index: int, effect: str) -> tuple[int, str, float]:
     return index, effect, j['baseline_er_percent'] / j['noise_floor_percent']
 
 
-def main() -> None:
+def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument('--n', type=int, default=180)
     ap.add_argument('--workers', type=int, default=2)
@@ -118,7 +118,7 @@ def main() -> None:
     checks = [(c['index'], c['effects'][0]) for c in cases
               if len(c['effects']) == 1 and c['index'] in blind][:args.check]
     costs: dict[str, dict[str, float]] = {}
-    t0 = time.time()
+    disagree, t0 = 0, time.time()
     with ProcessPoolExecutor(max_workers=args.workers) as pool:
         futures = [pool.submit(alone_cost, i, e) for i, e in tasks + checks]
         for k, fut in enumerate(as_completed(futures), 1):
@@ -126,13 +126,19 @@ def main() -> None:
             if (i, e) in checks:
                 print(f'check #{i} {e}: alone {cost:.3f} x, blind run {blind[i]["cost"]:.3f} x',
                       flush=True)
+                disagree += abs(cost - blind[i]['cost']) > 1e-6 * blind[i]['cost']
                 continue
             costs.setdefault(str(i), {})[e] = cost
             print(f'[{k}/{len(futures)} {time.time() - t0:.0f} s] #{i} {e} alone: '
                   f'{cost:.2f} x (with both: {blind[i]["cost"]:.2f} x)', flush=True)
+    if disagree:
+        print(f'{disagree} check(s) disagree with the blind run: the procedure is not the '
+              "blind run's (another code or machine?); nothing written")
+        return 1
     OUT.write_text(json.dumps({k: costs[k] for k in sorted(costs, key=int)}, indent=1) + '\n')
     print(f'wrote {OUT.relative_to(ROOT)}')
+    return 0
 
 
 if __name__ == '__main__':
-    main()
+    sys.exit(main())

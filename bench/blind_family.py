@@ -179,7 +179,7 @@ def draw(index: int, only: frozenset | None = None) -> dict:
     zero = rng.uniform(-10, 10) * k       # the reading of y = 0 (gain_drift's pivot)
     return {'index': index, 'channel': channel, 'excitation': kind, 'dt_s': dt,
             'effects': sorted(on),
-            'magnitudes': {e: mags[e] for e in sorted(on)}, 't': t, 'command': a * v + b,
+            'magnitudes': {e: m for e, m in mags.items() if e in on}, 't': t, 'command': a * v + b,
             'measurement': k * y + zero, 'sensor_zero': zero,
             'noise_percent_of_span': 100.0 * sigma / span,
             # the reference chain's parameters, for the command before its affine map

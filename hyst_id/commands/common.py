@@ -27,8 +27,8 @@ from hyst_id.identification.chains import CHAIN_NAMES, ChainSpec
 from hyst_id.io.recording import Recording
 
 __all__ = ['add_output_arguments', 'add_recording_arguments', 'add_settings_arguments',
-           'load_recording', 'make_spec', 'make_settings', 'parse_columns', 'prepare_outputs',
-           'progress_bar']
+           'load_recording', 'make_output_folder', 'make_spec', 'make_settings', 'parse_columns',
+           'prepare_outputs', 'progress_bar']
 
 
 def add_recording_arguments(parser: argparse.ArgumentParser) -> None:
@@ -150,17 +150,18 @@ def prepare_outputs(args: argparse.Namespace, *, plot_is_folder: bool) -> None:
             flag = '--' + opt.replace('_', '-')
             if Path(value).is_dir():
                 raise ConfigError(f'{flag} {value}: a folder; give a file name')
-            _make_folder(Path(value).parent, flag, value)
+            make_output_folder(Path(value).parent, flag, value)
     plot = getattr(args, 'plot', None)
     if plot:
         path = Path(plot)
         if plot_is_folder or path.is_dir() or path.suffix == '':
-            _make_folder(path, '--plot', plot)
+            make_output_folder(path, '--plot', plot)
         else:
-            _make_folder(path.parent, '--plot', plot)
+            make_output_folder(path.parent, '--plot', plot)
 
 
-def _make_folder(folder: Path, flag: str, value: str) -> None:
+def make_output_folder(folder: Path, flag: str, value: str) -> None:
+    """Make ``folder`` and its parents for the output ``flag value``; ConfigError if it cannot."""
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except (FileExistsError, NotADirectoryError):

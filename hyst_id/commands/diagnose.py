@@ -113,7 +113,8 @@ def _write_params(diag, path: str) -> None:
     limits = command_limits_for(diag.command)
     write_compensator_params(values, path, command_limits=limits)
     if limits is not None:
-        print(f'compensator: min_command {limits[0]:g}, max_command {limits[1]:g} (the '
+        print(f'compensator: min_command {limits[0]:g}, max_command {limits[1]:g}, '
+              f'initial_command {limits[2]:g} (the '
               "recording's commands leave the node's default 4-20)", file=sys.stderr)
     diag.extra['compensator'] = {'params_out': str(path),
                                  'applied': [{'mechanism': m, 'how': how} for m, how in applied]}

@@ -23,7 +23,7 @@ from pathlib import Path
 import re
 import sys
 
-from hyst_id.commands.common import parse_columns, progress_bar
+from hyst_id.commands.common import make_output_folder, parse_columns, progress_bar
 from hyst_id.errors import ConfigError
 from hyst_id.fleet import find_recordings, FleetOptions, loop_trends, run_fleet, write_table
 from hyst_id.fleet.table import fleet_rows
@@ -85,12 +85,10 @@ def run(args: argparse.Namespace) -> int:
     if args.time_scale is not None and not (math.isfinite(args.time_scale)
                                             and args.time_scale > 0.0):
         raise ConfigError(f'--time-scale must be a finite number > 0, got {args.time_scale}')
-    out = Path(args.out)
-    if out.exists() and not out.is_dir():
-        raise ConfigError(f'--out {args.out}: a file, not a folder')
     recordings = find_recordings(args.inputs)
     if not recordings:
         raise ConfigError(f'no recordings found under {", ".join(args.inputs)}')
+    make_output_folder(Path(args.out), '--out', args.out)
     topics = None
     if args.topics:
         from hyst_id.io.topics import load_topic_config

@@ -98,8 +98,8 @@ def run(args: argparse.Namespace) -> int:
         limits = command_limits_for(rec.command)
         write_compensator_params(ident, args.params_out, command_limits=limits)
         said = '' if limits is None else (
-            f" (with min_command {limits[0]:g}, max_command {limits[1]:g}: the recording's "
-            "commands leave the node's default 4-20)")
+            f' (with min_command {limits[0]:g}, max_command {limits[1]:g}, initial_command '
+            f"{limits[2]:g}: the recording's commands leave the node's default 4-20)")
         print(f'wrote {args.params_out}{said}', file=sys.stderr)
     return 0
 

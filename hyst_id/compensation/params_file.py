@@ -69,21 +69,26 @@ __all__ = ['COMPENSATOR_NAMES', 'ALL_MODEL_NAMES', 'NODE_COMMAND_LIMITS', 'comma
 NODE_COMMAND_LIMITS = (4.0, 20.0)
 
 
-def command_limits_for(command: Any) -> tuple[float, float] | None:
+#: The node's bounds on any command parameter.
+_NODE_COMMAND_BOUND = 1e6
+
+
+def command_limits_for(command: Any) -> tuple[float, float, float] | None:
     """Command limits for a params file: the recording's range when it leaves the node's defaults.
 
     None when every command of the recording lies within
     :data:`NODE_COMMAND_LIMITS` (the defaults fit, nothing is written);
-    else the recording's lowest and highest command, the range the set was
-    identified on (an actuator driven in volts or mm, not mA, would otherwise
-    have its commands clamped to 4-20).
+    else ``(lowest, highest, first)`` command of the recording, the range the
+    set was identified on and where it started (an actuator driven in volts or
+    mm, not mA, would otherwise have its commands clamped to 4-20 and start
+    at 9), within the node's bounds of +-1e6.
     """
     import numpy as np
-    arr = np.asarray(command, dtype=float)
+    arr = np.clip(np.asarray(command, dtype=float), -_NODE_COMMAND_BOUND, _NODE_COMMAND_BOUND)
     lo, hi = float(np.min(arr)), float(np.max(arr))
     if NODE_COMMAND_LIMITS[0] <= lo and hi <= NODE_COMMAND_LIMITS[1]:
         return None
-    return lo, hi
+    return lo, hi, float(arr[0])
 
 
 def compensator_names(family: str | None = None) -> tuple[str, ...]:
@@ -185,7 +190,7 @@ def _augment_values(*sources: Any) -> dict[str, Any]:
 
 def write_compensator_params(identification_or_dict: Any, path: str | Path,
                              node_name: str = '/**',
-                             command_limits: tuple[float, float] | None = None) -> Path:
+                             command_limits: tuple[float, ...] | None = None) -> Path:
     """Write a ROS 2 params file for the compensator node.
 
     Parameters
@@ -197,9 +202,10 @@ def write_compensator_params(identification_or_dict: Any, path: str | Path,
     node_name : str
         Node name the section is keyed by: ``/**`` (default) for any node in
         any namespace, ``/**/compensator`` for nodes of that name only.
-    command_limits : (float, float), optional
-        Written as the node's ``min_command`` and ``max_command``
-        (:func:`command_limits_for`); None: the node's defaults hold.
+    command_limits : (float, float) or (float, float, float), optional
+        Written as the node's ``min_command``, ``max_command`` and, when given,
+        ``initial_command`` (:func:`command_limits_for`); None: the node's
+        defaults hold.
 
     Returns
     -------
@@ -223,11 +229,14 @@ def write_compensator_params(identification_or_dict: Any, path: str | Path,
     for name in compensator_names(values['family']) + ('output_sign', 'er_percent'):
         lines.append(f'    {name}: {_yaml_float(values[name])}')
     if command_limits is not None:
-        lo, hi = (float(x) for x in command_limits)
-        if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
-            raise ConfigError(f'command limits need finite min < max, got {command_limits}')
+        lo, hi, *first = (float(x) for x in command_limits)
+        if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi
+                and all(lo <= v <= hi for v in first)):
+            raise ConfigError('command limits need finite min < max (and a first command '
+                              f'between), got {command_limits}')
         lines += ["    # the recording's command range (the node's default is 4-20)",
                   f'    min_command: {_yaml_float(lo)}', f'    max_command: {_yaml_float(hi)}']
+        lines += [f'    initial_command: {_yaml_float(v)}' for v in first]
     aug = {k[len(AUGMENT_PREFIX):]: v for k, v in values.items() if k.startswith(AUGMENT_PREFIX)}
     if aug:
         lines.append('    augment:')

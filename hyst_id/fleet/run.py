@@ -39,7 +39,7 @@ import time
 from typing import Any, Callable, Iterable
 
 from hyst_id.errors import ConfigError, HystIdError
-from hyst_id.identification.workers import map_in_processes
+from hyst_id.identification.workers import map_in_processes, n_processes
 
 __all__ = ['FleetOptions', 'find_recordings', 'fleet_task', 'result_path', 'run_fleet']
 
@@ -57,9 +57,10 @@ class FleetOptions:
     diagnose: bool = False
     #: A :class:`~hyst_id.io.topics.TopicConfig` or mapping of topic keys (bags), or None.
     topics: Any = None
-    #: CSV columns (time, command, measurement; names or 0-based indices), None: the default.
+    #: CSV columns (time, command, measurement; names or 0-based indices), None: the
+    #: default; bags in the same fleet are read by their topics.
     columns: tuple | None = None
-    #: Factor from the CSV time column to seconds, None: 1.
+    #: Factor from the CSV time column to seconds (CSV files only), None: 1.
     time_scale: float | None = None
 
 
@@ -118,10 +119,12 @@ def fleet_task(path: str, options: FleetOptions) -> dict:
     try:
         from hyst_id.identification import identify
         from hyst_id.identification.config import make_settings, make_spec
-        from hyst_id.io.readers import read_recording
+        from hyst_id.io.readers import CSV_SUFFIXES, read_recording
 
+        csv = Path(path).suffix.lower() in CSV_SUFFIXES     # columns are a CSV's only
         rec = read_recording(path, options.channel, topics=options.topics or None,
-                             columns=options.columns, time_scale=options.time_scale)
+                             columns=options.columns if csv else None,
+                             time_scale=options.time_scale if csv else None)
         spec = make_spec(rec, 'auto', family=options.model)
         settings = make_settings(seeds=options.seeds, generations=options.generations,
                                  workers=1)
@@ -194,7 +197,7 @@ def run_fleet(recordings: list[Path], out_dir: str | Path, options: FleetOptions
 
     if todo and not address:
         map_in_processes(fleet_task, [(str(rec), options) for rec in todo],
-                         workers or os.cpu_count() or 1, on_result=keep)
+                         n_processes(workers, len(todo)), on_result=keep)
     elif todo:
         executor, close = _dask_executor(address, workers)
         try:

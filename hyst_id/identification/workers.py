@@ -210,6 +210,25 @@ class ForkedPool(ProcessPoolExecutor):
     def __init__(self, *args: Any, interrupted: Callable[[], bool], **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
         self._interrupted = interrupted
+        self._futures: list[Future] = []
+
+    def submit(self, fn: Callable[..., Any], /, *args: Any, **kwargs: Any) -> Future:
+        """:meth:`ProcessPoolExecutor.submit`, the future kept for :meth:`drain`."""
+        future = super().submit(fn, *args, **kwargs)
+        self._futures.append(future)
+        return future
+
+    def drain(self) -> None:
+        """Drop the queued tasks and wait for the running ones in polls (Ctrl-C raised)."""
+        for future in self._futures:
+            future.cancel()
+        left = {f for f in self._futures if not f.done()}
+        while left:
+            if self._interrupted():
+                raise KeyboardInterrupt
+            _, left = wait(left, timeout=POLL_S)
+        if self._interrupted():
+            raise KeyboardInterrupt
 
     def result(self, future: Future) -> Any:
         """``future.result()``, raising a noted Ctrl-C as :class:`KeyboardInterrupt` first."""
@@ -243,6 +262,5 @@ def forked_pool(n_workers: int) -> Iterator[ForkedPool | None]:
                           initargs=(os.getpid(),), interrupted=interrupted)
         with _ended_on_error(pool):
             yield pool
-            if interrupted():
-                raise KeyboardInterrupt
-        pool.shutdown(wait=True, cancel_futures=True)
+            pool.drain()    # the running tasks end unread, a Ctrl-C meanwhile ends them
+        pool.shutdown(wait=True)

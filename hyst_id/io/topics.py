@@ -228,15 +228,21 @@ def _node_sections(doc: dict, prefix: str = '') -> list[tuple[str, str, Any]]:
 def node_parameters_in(yaml_path: str | Path) -> list[str]:
     """The keys of a params file's node sections that are not topics or fields (sorted).
 
-    What a node reads (GAASS settings, QoS, ...) and a recording's reader does
-    not: the CLI names them so that a user does not take them as applied.
+    What a node reads (GAASS settings, QoS, its own streams such as
+    ``topics.identified_params_topic``) and a recording's reader does not:
+    the CLI names them so that a user does not take them as applied, and a
+    misspelt topic key (``topics.comand_topic``) shows up among them.
     """
     doc = read_yaml(Path(yaml_path))
+    known = _KEYS | NODE_STREAM_KEYS
     keys: set[str] = set()
     for _, _, params in _node_sections(doc if isinstance(doc, dict) else {}):
-        if isinstance(params, dict):
-            keys |= {str(k) for k in params if k != 'topics' and not str(k).startswith(
-                'topics.') and k not in _KEYS and k not in NODE_STREAM_KEYS}
+        if not isinstance(params, dict):
+            continue
+        keys |= {str(k) for k in params if k != 'topics'
+                 and str(k).removeprefix('topics.') not in known}
+        if isinstance(params.get('topics'), dict):   # a node's own streams, or a typo
+            keys |= {f'topics.{k}' for k in params['topics'] if k not in known}
     return sorted(keys)
 
 

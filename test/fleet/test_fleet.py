@@ -131,14 +131,17 @@ def test_cli_fleet_reads_headerless_csv_columns_and_refuses_bad_options(tmp_path
     out = tmp_path / 'out'
     args = ['fleet', str(folder), '--out', str(out), '--seeds', '1', '--generations', '40',
             '--workers', '1', '--no-progress']
+    write_recording_bag(folder / 'bag', rec)        # a bag in the same fleet: read by topics
     assert cli_main(args + ['--columns', '0,2,1', '--time-scale', '0.001']) == 0
-    doc = json.loads(next((out / 'recordings').glob('*.json')).read_text())
-    assert doc['status'] == 'ok' and doc['duration_s'] == pytest.approx(rec.duration_s)
+    docs = [json.loads(f.read_text()) for f in (out / 'recordings').glob('*.json')]
+    assert len(docs) == 2 and all(d['status'] == 'ok' for d in docs), docs
+    assert all(d['duration_s'] == pytest.approx(rec.duration_s) for d in docs)
     capsys.readouterr()
     for extra, needle in ((['--seeds', '0'], 'seeds >= 1'), (['--workers', '-1'], 'workers'),
                           (['--columns', '0,1,1'], 'three different columns'),
                           (['--time-scale', '0'], '--time-scale must be'),
-                          (['--out', str(folder / 'run.csv')], 'a file, not a folder')):
+                          (['--out', str(folder / 'run.csv')], 'a file, not a folder'),
+                          (['--out', str(folder / 'run.csv' / 'sub')], 'a file, not a folder')):
         assert cli_main(args + extra) == 2, extra
         err = capsys.readouterr().err
         assert needle in err and 'internal error' not in err, err
@@ -182,6 +185,10 @@ def test_an_interrupted_local_fleet_keeps_what_arrived_and_ends_its_workers(tmp_
                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     try:
         workers = [int(proc.stdout.readline().split()[1]) for _ in range(2)]
+        deadline = time.monotonic() + 20.0      # the fast row written (its result read)
+        while not list((tmp_path / 'recordings').glob('*.json')) and \
+                time.monotonic() < deadline:
+            time.sleep(0.05)
         proc.send_signal(signal.SIGINT)
         t0 = time.monotonic()
         proc.wait(timeout=20)

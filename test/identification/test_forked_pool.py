@@ -15,7 +15,8 @@
 """Ctrl-C in a forked pool (basin hopping's and the incumbent's polishes).
 
 A Ctrl-C while the pool is open is noted and raised at the next wait
-(``ForkedPool.result``), never inside the executor's own calls, and the
+(``ForkedPool.result``, or the pool's own wait for the tasks still running
+when the block ends), never inside the executor's own calls, and the
 workers end with the parent. Each case runs in a fresh process (a pool only
 forks with one thread running, and the signal must reach a main thread with
 Python's default handler).
@@ -42,18 +43,19 @@ def slow(seconds):
     return seconds
 
 
-early = sys.argv[1] == 'early'
-with forked_pool(2) as pool:
-    print('pool', pool is not None, flush=True)
-    if early:
-        os.kill(os.getpid(), signal.SIGINT)     # before the submits: noted only
-    futures = [pool.submit(slow, 30.0) for _ in range(4)]
-    print('workers', *pool._processes, flush=True)
-    try:
-        pool.result(futures[0])
-    except KeyboardInterrupt:
-        print('interrupted', flush=True)
-        raise
+when = sys.argv[1]
+try:
+    with forked_pool(2) as pool:
+        print('pool', pool is not None, flush=True)
+        if when == 'early':
+            os.kill(os.getpid(), signal.SIGINT)     # before the submits: noted only
+        futures = [pool.submit(slow, 30.0) for _ in range(4)]
+        print('workers', *pool._processes, flush=True)
+        if when != 'closing':       # closing: the block ends with the tasks running
+            pool.result(futures[0])
+except KeyboardInterrupt:
+    print('interrupted', flush=True)
+    raise
 print('not interrupted', flush=True)
 """
 
@@ -67,7 +69,7 @@ def _alive(pid: int) -> bool:
 
 
 @pytest.mark.skipif(not sys.platform.startswith('linux'), reason='fork, /proc')
-@pytest.mark.parametrize('when', ['early', 'waiting'])
+@pytest.mark.parametrize('when', ['early', 'waiting', 'closing'])
 def test_ctrl_c_in_a_forked_pool_is_raised_at_the_wait_and_ends_the_workers(when):
     proc = subprocess.Popen([sys.executable, '-c', _SCRIPT, when], stdout=subprocess.PIPE,
                             stderr=subprocess.STDOUT, text=True)
@@ -76,7 +78,7 @@ def test_ctrl_c_in_a_forked_pool_is_raised_at_the_wait_and_ends_the_workers(when
         workers = [int(p) for p in proc.stdout.readline().split()[1:]]
         assert workers, 'no worker process started'
         t0 = time.monotonic()
-        if when == 'waiting':
+        if when != 'early':
             time.sleep(0.5)
             proc.send_signal(signal.SIGINT)
         proc.wait(timeout=20)

@@ -521,7 +521,10 @@ def test_topic_config_namespaces_and_strays(tmp_path: Path) -> None:
                     '      seeds: 2\n      command_topic: /v1/cmd\n      topics:\n'
                     '        identified_params_topic: /x\n')
     assert load_topic_config(nested, 'position').command_topic == '/v1/cmd'
-    assert node_parameters_in(nested) == ['seeds']
+    assert node_parameters_in(nested) == ['seeds', 'topics.identified_params_topic']
+    typo = _write(tmp_path / 't.yaml', '/**:\n  ros__parameters:\n    topics:\n'
+                  '      comand_topic: /rig/cmd\n    topics.pressure_unit: Pa\n')
+    assert node_parameters_in(typo) == ['topics.comand_topic']     # named, not dropped
     stray = _write(tmp_path / 's.yaml', 'seeds: 1\ntopics:\n  command_topic: /c\n')
     assert "unknown top-level key(s) ['seeds']" in _raises(ConfigError, load_topic_config,
                                                            stray, 'flow')

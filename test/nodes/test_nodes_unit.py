@@ -186,8 +186,8 @@ def test_bad_params_file_is_a_one_line_config_error(ros_domain, tmp_path):
 def test_a_set_of_an_actuator_outside_4_20_brings_its_command_limits(ros_domain, tmp_path):
     """A set identified in volts (``--params-out``): the node clamps to its range, not 4-20."""
     assert command_limits_for(np.linspace(7.0, 11.0, 5)) is None      # the defaults fit
-    limits = command_limits_for(np.array([-150.0, 0.0, 150.0]))
-    assert limits == (-150.0, 150.0)
+    limits = command_limits_for(np.array([0.0, -150.0, 150.0]))
+    assert limits == (-150.0, 150.0, 0.0)
     path = write_compensator_params({'channel': 'position', 'params': dict(PAPER)},
                                     tmp_path / 'c.yaml', command_limits=limits)
     with pytest.raises(ConfigError, match='finite min < max'):
@@ -199,7 +199,8 @@ def test_a_set_of_an_actuator_outside_4_20_brings_its_command_limits(ros_domain,
     try:
         comp = Compensator(context=context)
         try:
-            assert (comp.p('min_command'), comp.p('max_command')) == (-150.0, 150.0)
+            assert (comp.p('min_command'), comp.p('max_command'),
+                    comp.p('initial_command')) == (-150.0, 150.0, 0.0)
         finally:
             comp.destroy_node()
     finally:
