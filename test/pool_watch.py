@@ -12,7 +12,7 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
-"""Which forked pools a module used: for the tests that compare one worker with two.
+"""Which forked pools a module used, and which workers outlived a pool: for the pool tests.
 
 Those comparisons run in a fresh process (``subprocess``), which has one
 thread, so that the pools really fork; a pytest worker may have threads left
@@ -23,11 +23,14 @@ compare one process with itself.
 from __future__ import annotations
 
 from contextlib import contextmanager
+import os
 from pathlib import Path
+import signal
 import subprocess
 import sys
+import time
 
-__all__ = ['in_fresh_process', 'watch_pools']
+__all__ = ['in_fresh_process', 'watch_pools', 'workers_left']
 
 
 def watch_pools(module) -> list:
@@ -55,3 +58,26 @@ def in_fresh_process(test_file: str, call: str) -> subprocess.CompletedProcess:
             f'import {Path(test_file).stem} as m; m.{call}')
     return subprocess.run([sys.executable, '-c', code], capture_output=True, text=True,
                           timeout=600)
+
+
+def workers_left(pids: list[int], timeout_s: float = 10.0) -> list[int]:
+    """Which of the processes ``pids`` still live after ``timeout_s``; those are killed (Linux).
+
+    For the tests that end a pool and check that no worker outlives it.
+    """
+    deadline = time.monotonic() + timeout_s
+    while any(_alive(p) for p in pids) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    left = [p for p in pids if _alive(p)]
+    for pid in left:
+        os.kill(pid, signal.SIGKILL)
+    return left
+
+
+def _alive(pid: int) -> bool:
+    """Running and not a zombie (``/proc``)."""
+    try:
+        with open(f'/proc/{pid}/stat') as f:
+            return f.read().rsplit(')', 1)[1].split()[0] != 'Z'
+    except OSError:
+        return False

@@ -24,13 +24,13 @@ without excitation are in the same fleet.
 from __future__ import annotations
 
 import json
-import os
 import signal
 import subprocess
 import sys
 import time
 
 import numpy as np
+from pool_watch import workers_left
 import pytest
 from reference_sim import backlash, hysteresis
 
@@ -199,20 +199,7 @@ def test_an_interrupted_local_fleet_keeps_what_arrived_and_ends_its_workers(tmp_
             proc.kill()
     assert proc.returncode != 0 and 'KeyboardInterrupt' in out, out[-2000:]
     assert took_s < 10.0, f'{took_s:.1f} s from the Ctrl-C to the exit (tasks sleep 60 s)'
-    deadline = time.monotonic() + 10.0
-    while any(_alive(p) for p in workers) and time.monotonic() < deadline:
-        time.sleep(0.1)
-    left = [p for p in workers if _alive(p)]
-    for pid in left:
-        os.kill(pid, signal.SIGKILL)
+    left = workers_left(workers)
     assert not left, f'worker(s) {left} outlived the interrupted fleet'
     kept = [json.loads(f.read_text()) for f in (tmp_path / 'recordings').glob('*.json')]
     assert [d['recording'] for d in kept] == [str(tmp_path / 'fast')]
-
-
-def _alive(pid: int) -> bool:
-    try:
-        with open(f'/proc/{pid}/stat') as f:
-            return f.read().rsplit(')', 1)[1].split()[0] != 'Z'
-    except OSError:
-        return False

@@ -24,12 +24,12 @@ Python's default handler).
 
 from __future__ import annotations
 
-import os
 import signal
 import subprocess
 import sys
 import time
 
+from pool_watch import workers_left
 import pytest
 
 _SCRIPT = r"""
@@ -60,14 +60,6 @@ print('not interrupted', flush=True)
 """
 
 
-def _alive(pid: int) -> bool:
-    try:
-        with open(f'/proc/{pid}/stat') as f:
-            return f.read().rsplit(')', 1)[1].split()[0] != 'Z'
-    except OSError:
-        return False
-
-
 @pytest.mark.skipif(not sys.platform.startswith('linux'), reason='fork, /proc')
 @pytest.mark.parametrize('when', ['early', 'waiting', 'closing'])
 def test_ctrl_c_in_a_forked_pool_is_raised_at_the_wait_and_ends_the_workers(when):
@@ -91,10 +83,5 @@ def test_ctrl_c_in_a_forked_pool_is_raised_at_the_wait_and_ends_the_workers(when
     assert 'not interrupted' not in out
     assert proc.returncode != 0 and 'KeyboardInterrupt' in out
     assert took_s < 10.0, f'{took_s:.1f} s from the Ctrl-C to the exit (tasks sleep 30 s)'
-    deadline = time.monotonic() + 10.0
-    while any(_alive(p) for p in workers) and time.monotonic() < deadline:
-        time.sleep(0.1)
-    left = [p for p in workers if _alive(p)]
-    for pid in left:
-        os.kill(pid, signal.SIGKILL)
+    left = workers_left(workers)
     assert not left, f'worker(s) {left} outlived the interrupted pool'
