@@ -81,10 +81,10 @@ from hyst_id.identification.chains import chain_spec, ChainSpec
 from hyst_id.io.recording import Recording, roundoff_probe, validate_recording
 from hyst_id.signals.noise import floor_percent
 from hyst_id.signals.reversals import period_s
-from hyst_id.signals.split import inside_rows, split_index
+from hyst_id.signals.split import inside_rows, level_excursion, split_index
 
 __all__ = ['UNKNOWN_FACTOR', 'WHOLE_RECORD_FACTOR', 'diagnose', 'finding_from', 'gain_call',
-           'located_where', 'range_note']
+           'level_note', 'located_where', 'range_note']
 
 #: Held-out %e_r over the noise floor above which what is left counts as missing physics.
 UNKNOWN_FACTOR = 1.5
@@ -322,6 +322,7 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
     if current.er_holdout_percent > UNKNOWN_FACTOR * floor_h:
         say('empirical block: what a model could still gain')
         empirical = empirical_block(t, v_orig, y, current.prediction, n_train, ctx.period_s)
+        notes += level_note(y, n_train)
     extra = {} if current is baseline else {'blocked_cv': blocked.confirm(baseline, current)}
     if withdrawn:
         extra['withdrawn'] = withdrawn
@@ -485,6 +486,17 @@ def range_note(v: np.ndarray, n_train: int, n_judged: int | None = None) -> list
                      'samples, before the command first leaves the training range')
         return [note]
     return []
+
+
+def level_note(y: np.ndarray, n_train: int) -> list[str]:
+    """A note when a fifth or more of the held-out measurement lies beyond the training levels."""
+    share, lo, hi, lo_h, hi_h = level_excursion(y, n_train)
+    if share < 0.2:
+        return []
+    return [f'{100 * share:.0f} % of the held-out measurement lies beyond the levels of the '
+            f'training part ({lo_h:.4g} to {hi_h:.4g} against {lo:.4g} to {hi:.4g}): an end '
+            'stop or plateau reached only later, or a drift; blocks fitted on the training '
+            'part were never shown those levels, so the split can leave them undecided']
 
 
 def _judged(data: Data, baseline: FitResult, final: FitResult) -> dict:

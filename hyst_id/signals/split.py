@@ -16,11 +16,13 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from hyst_id.errors import ConfigError
 
-__all__ = ['inside_rows', 'split_index']
+__all__ = ['inside_rows', 'level_excursion', 'split_index']
 
 
 def split_index(t_s: np.ndarray, train_fraction: float) -> int:
@@ -81,3 +83,28 @@ def inside_rows(command: np.ndarray, n_train: int, *, tol: float = 0.02,
     if stop - n_train < max(min_samples, min_share * (n - n_train)):
         stop = n
     return np.arange(n_train, stop)
+
+
+def level_excursion(measurement: np.ndarray, n_train: int, *,
+                    tol: float = 0.02) -> tuple[float, float, float, float, float]:
+    """Share of held-out samples whose measurement lies beyond the training part's range.
+
+    Beyond by more than ``tol`` of that range. The command may stay inside
+    its training range while the response does not (an end stop or plateau
+    reached only later, a drift): no block fitted on the training part was
+    shown those levels.
+
+    Returns
+    -------
+    tuple of float
+        ``(share, train_low, train_high, held_out_low, held_out_high)``; share 0
+        without held-out samples.
+    """
+    y = np.asarray(measurement, dtype=float)
+    if n_train >= y.size or n_train < 1:
+        return 0.0, math.nan, math.nan, math.nan, math.nan
+    lo, hi = float(np.min(y[:n_train])), float(np.max(y[:n_train]))
+    held = y[n_train:]
+    margin = tol * (hi - lo)
+    share = float(np.mean((held < lo - margin) | (held > hi + margin)))
+    return share, lo, hi, float(np.min(held)), float(np.max(held))

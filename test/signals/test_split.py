@@ -49,3 +49,19 @@ def test_all_held_out_rows_when_the_command_stays_inside_or_leaves_at_once():
     # a small overshoot (under 2 % of the range) is not an excursion
     u = np.concatenate([np.linspace(0, 10, 700), np.full(300, 10.15)])
     assert inside_rows(u, 700).size == 300
+
+
+def test_level_excursion_finds_a_held_out_plateau_the_training_part_never_reached():
+    """The command stays inside, the response rises to a plateau only after the split."""
+    from hyst_id.diagnosis.driver import level_note
+    from hyst_id.signals.split import level_excursion
+    t = np.linspace(0.0, 20.0, 2000)
+    rng = np.random.default_rng(1)
+    climbing = (np.clip(2.0 * (t - 14.0), 0.0, 1.0) * 0.5 + 0.05 * np.sin(2 * np.pi * t)
+                + rng.normal(0, 1e-3, t.size))      # up to a plateau half a second after 14 s
+    share, lo, hi, lo_h, hi_h = level_excursion(climbing, 1400)
+    assert share > 0.5 and hi_h > hi and lo < lo_h
+    assert level_note(climbing, 1400)[0].startswith(f'{100 * share:.0f} % of the held-out')
+    steady = 0.05 * np.sin(2 * np.pi * t) + rng.normal(0, 1e-3, t.size)
+    assert level_excursion(steady, 1400)[0] == 0.0 and level_note(steady, 1400) == []
+    assert level_excursion(steady, steady.size)[0] == 0.0          # nothing held out
