@@ -322,7 +322,7 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
     if current.er_holdout_percent > UNKNOWN_FACTOR * floor_h:
         say('empirical block: what a model could still gain')
         empirical = empirical_block(t, v_orig, y, current.prediction, n_train, ctx.period_s)
-        notes += level_note(y, n_train)
+        notes += [] if range_note(v_orig, n_train) else level_note(y, n_train)
     extra = {} if current is baseline else {'blocked_cv': blocked.confirm(baseline, current)}
     if withdrawn:
         extra['withdrawn'] = withdrawn
@@ -489,7 +489,11 @@ def range_note(v: np.ndarray, n_train: int, n_judged: int | None = None) -> list
 
 
 def level_note(y: np.ndarray, n_train: int) -> list[str]:
-    """A note when a fifth or more of the held-out measurement lies beyond the training levels."""
+    """A note when a fifth or more of the held-out measurement lies beyond the training levels.
+
+    Made only when the held-out command stays inside its training range (else
+    :func:`range_note` already names the likelier cause).
+    """
     share, lo, hi, lo_h, hi_h = level_excursion(y, n_train)
     if share < 0.2:
         return []
