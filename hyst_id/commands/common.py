@@ -24,11 +24,12 @@ from typing import Any
 from hyst_id.errors import ConfigError
 from hyst_id.identification import config, IdentifySettings
 from hyst_id.identification.chains import CHAIN_NAMES, ChainSpec
+from hyst_id.io.outputs import make_output_folder, names_folder
 from hyst_id.io.recording import Recording
 
 __all__ = ['add_output_arguments', 'add_recording_arguments', 'add_settings_arguments',
-           'load_recording', 'make_output_folder', 'make_spec', 'make_settings', 'parse_columns',
-           'prepare_outputs', 'progress_bar']
+           'load_recording', 'make_spec', 'make_settings', 'parse_columns', 'prepare_outputs',
+           'progress_bar']
 
 
 def add_recording_arguments(parser: argparse.ArgumentParser) -> None:
@@ -106,10 +107,9 @@ def add_settings_arguments(parser: argparse.ArgumentParser, identify: bool = Tru
 def load_recording(args: argparse.Namespace) -> Recording:
     """Read and validate the recording named on the command line."""
     from hyst_id.io.readers import read_recording
-    from hyst_id.io.topics import load_topic_config, node_parameters_in
+    from hyst_id.io.topics import load_topic_file
 
-    topics = load_topic_config(args.params, args.channel) if args.params else None
-    unused = node_parameters_in(args.params) if args.params else []
+    topics, unused = load_topic_file(args.params, args.channel) if args.params else (None, [])
     if unused:
         print(f'note: {args.params}: only topics and fields are read here; node parameters '
               f'{", ".join(unused[:8])}{" ..." if len(unused) > 8 else ""} are not used (give '
@@ -141,8 +141,10 @@ def prepare_outputs(args: argparse.Namespace, *, plot_is_folder: bool) -> None:
     A file output (``--json``, ``--params-out``, ``--sim-out``) that names a
     folder or lies under a file, and a ``--plot`` folder that is a file, are
     a :class:`ConfigError` (exit 2) before the identification runs, not an
-    error after it. ``plot_is_folder``: ``--plot`` names a folder (identify);
-    else a name with a suffix is a file (diagnose's ``FILE.png|DIR``).
+    error after it. ``plot_is_folder``: ``--plot`` must name a folder
+    (identify writes several figures; a figure's file name is refused); else
+    a figure's file name is a file (diagnose's ``FILE.png|DIR``,
+    :func:`hyst_id.io.outputs.names_folder`).
     """
     for opt in ('json', 'params_out', 'sim_out'):
         value = getattr(args, opt, None)
@@ -154,21 +156,13 @@ def prepare_outputs(args: argparse.Namespace, *, plot_is_folder: bool) -> None:
     plot = getattr(args, 'plot', None)
     if plot:
         path = Path(plot)
-        if plot_is_folder or path.is_dir() or path.suffix == '':
+        if names_folder(path):
             make_output_folder(path, '--plot', plot)
+        elif plot_is_folder:
+            raise ConfigError(f'--plot {plot}: a folder for the figures this command writes '
+                              f'(several); give a folder name, e.g. {path.with_suffix("")}')
         else:
             make_output_folder(path.parent, '--plot', plot)
-
-
-def make_output_folder(folder: Path, flag: str, value: str) -> None:
-    """Make ``folder`` and its parents for the output ``flag value``; ConfigError if it cannot."""
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-    except (FileExistsError, NotADirectoryError):
-        raise ConfigError(f'{flag} {value}: {folder} is a file, not a folder') from None
-    except OSError as exc:
-        raise ConfigError(f'{flag} {value}: cannot make the folder {folder}: '
-                          f'{exc.strerror}') from None
 
 
 def make_settings(args: argparse.Namespace) -> IdentifySettings:

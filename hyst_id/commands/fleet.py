@@ -23,11 +23,12 @@ from pathlib import Path
 import re
 import sys
 
-from hyst_id.commands.common import make_output_folder, parse_columns, progress_bar
+from hyst_id.commands.common import parse_columns, progress_bar
 from hyst_id.errors import ConfigError
 from hyst_id.fleet import find_recordings, FleetOptions, loop_trends, run_fleet, write_table
 from hyst_id.fleet.table import fleet_rows
 from hyst_id.identification.config import make_settings
+from hyst_id.io.outputs import make_output_folder
 from hyst_id.io.recording import CHANNELS
 
 __all__ = ['add_arguments', 'run']

@@ -229,7 +229,11 @@ def write_compensator_params(identification_or_dict: Any, path: str | Path,
     for name in compensator_names(values['family']) + ('output_sign', 'er_percent'):
         lines.append(f'    {name}: {_yaml_float(values[name])}')
     if command_limits is not None:
-        lo, hi, *first = (float(x) for x in command_limits)
+        values_in = [float(x) for x in command_limits]
+        if len(values_in) not in (2, 3):
+            raise ConfigError('command limits are (min, max) or (min, max, first command), '
+                              f'got {len(values_in)} values')
+        lo, hi, *first = values_in
         if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi
                 and all(lo <= v <= hi for v in first)):
             raise ConfigError('command limits need finite min < max (and a first command '

@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from hyst_id.diagnosis.blocked_cv import confirmed, summary as cv_summary
+from hyst_id.io.outputs import names_folder
 
 __all__ = ['format_diagnosis', 'plot_diagnosis', 'unknown_reading']
 
@@ -328,7 +329,7 @@ def plot_diagnosis(d: Any, path: str | Path, *, dpi: int = 110) -> Path:
     import matplotlib.pyplot as plt
 
     path = Path(path)
-    if path.is_dir() or path.suffix == '':
+    if names_folder(path):
         path.mkdir(parents=True, exist_ok=True)
         path = path / f'diagnosis_{d.channel}.png'
     t, y, nt = d.t_s, d.measurement, d.n_train

@@ -32,6 +32,7 @@ from concurrent.futures import as_completed, Executor
 from dataclasses import asdict, dataclass
 import glob
 import hashlib
+import itertools
 import json
 import os
 from pathlib import Path
@@ -185,15 +186,14 @@ def run_fleet(recordings: list[Path], out_dir: str | Path, options: FleetOptions
             docs[str(rec)] = {**old, 'resumed': True}
         else:
             todo.append(rec)
-    arrived = 0
+    arrived = itertools.count(1)
 
     def keep(doc: dict) -> None:
-        nonlocal arrived
-        arrived += 1
+        """Write a row as it arrives (an interrupted fleet keeps it), then report it."""
         _write(result_path(out_dir, Path(doc['recording'])), doc)
         docs[doc['recording']] = doc
         if progress:
-            progress(arrived, len(todo), doc)
+            progress(next(arrived), len(todo), doc)
 
     if todo and not address:
         map_in_processes(fleet_task, [(str(rec), options) for rec in todo],

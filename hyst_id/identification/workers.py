@@ -40,7 +40,7 @@ import os
 import signal
 import sys
 import threading
-from typing import Any, Callable, Iterator, Sequence
+from typing import Any, Callable, Iterable, Iterator, Sequence
 
 from threadpoolctl import threadpool_limits
 
@@ -222,23 +222,22 @@ class ForkedPool(ProcessPoolExecutor):
         """Drop the queued tasks and wait for the running ones in polls (Ctrl-C raised)."""
         for future in self._futures:
             future.cancel()
-        left = {f for f in self._futures if not f.done()}
+        self._wait_all(self._futures)
+
+    def result(self, future: Future) -> Any:
+        """``future.result()``, raising a noted Ctrl-C as :class:`KeyboardInterrupt` first."""
+        self._wait_all([future])
+        return future.result()
+
+    def _wait_all(self, futures: Iterable[Future]) -> None:
+        """Wait for ``futures`` in polls of :data:`POLL_S`; a noted Ctrl-C is raised."""
+        left = {f for f in futures if not f.done()}
         while left:
             if self._interrupted():
                 raise KeyboardInterrupt
             _, left = wait(left, timeout=POLL_S)
         if self._interrupted():
             raise KeyboardInterrupt
-
-    def result(self, future: Future) -> Any:
-        """``future.result()``, raising a noted Ctrl-C as :class:`KeyboardInterrupt` first."""
-        while not future.done():
-            if self._interrupted():
-                raise KeyboardInterrupt
-            wait([future], timeout=POLL_S)
-        if self._interrupted():
-            raise KeyboardInterrupt
-        return future.result()
 
 
 @contextmanager

@@ -25,6 +25,7 @@
 :mod:`.messages`          building ROS messages for bags without rclpy
 :mod:`.params_file`       reading YAML with one-line errors
 :mod:`.jsonable`          result objects to JSON
+:mod:`.outputs`           where outputs go (figure file or folder), folders made
 ========================  ===================================================
 
 May import: :mod:`hyst_id.signals`, rosbags, mcap; never rclpy.

@@ -33,7 +33,8 @@ from hyst_id.io.params_file import read_yaml
 from hyst_id.io.recording import CHANNELS
 
 __all__ = ['NamedIndex', 'NODE_STREAM_KEYS', 'TOPIC_FILE_KEYS', 'TopicConfig', 'get_field',
-           'load_topic_config', 'node_parameters_in', 'parse_field_path', 'value_field']
+           'load_topic_config', 'load_topic_file', 'node_parameters_in', 'parse_field_path',
+           'value_field']
 
 #: Per channel: topic, message type, field path, unit.
 _COMMAND_DEFAULTS = ('/hyst_id/command', 'std_msgs/msg/Float64', 'data', 'mA')
@@ -204,12 +205,6 @@ class TopicConfig:
         return cls(**values)
 
 
-def _holds_node_section(value: Any) -> bool:
-    """A node section (``ros__parameters``), or a namespace holding one (``/ns: node: ...``)."""
-    return isinstance(value, dict) and ('ros__parameters' in value or any(
-        _holds_node_section(v) for v in value.values()))
-
-
 def _node_sections(doc: dict, prefix: str = '') -> list[tuple[str, str, Any]]:
     """``(where, node name, ros__parameters)`` of every node section, namespaces walked."""
     out = []
@@ -233,7 +228,10 @@ def node_parameters_in(yaml_path: str | Path) -> list[str]:
     the CLI names them so that a user does not take them as applied, and a
     misspelt topic key (``topics.comand_topic``) shows up among them.
     """
-    doc = read_yaml(Path(yaml_path))
+    return _node_parameters(read_yaml(Path(yaml_path)))
+
+
+def _node_parameters(doc: Any) -> list[str]:
     known = _KEYS | NODE_STREAM_KEYS
     keys: set[str] = set()
     for _, _, params in _node_sections(doc if isinstance(doc, dict) else {}):
@@ -269,7 +267,17 @@ def load_topic_config(yaml_path: str | Path, channel: str, *,
         top-level ``topics:`` mapping, invalid values.
     """
     yaml_path = Path(yaml_path)
+    return _topic_config(read_yaml(yaml_path), yaml_path, channel, node)
+
+
+def load_topic_file(yaml_path: str | Path, channel: str) -> tuple[TopicConfig, list[str]]:
+    """:func:`load_topic_config` and :func:`node_parameters_in` of one read of the file."""
+    yaml_path = Path(yaml_path)
     doc = read_yaml(yaml_path)
+    return _topic_config(doc, yaml_path, channel, None), _node_parameters(doc)
+
+
+def _topic_config(doc: Any, yaml_path: Path, channel: str, node: str | None) -> TopicConfig:
     doc = {} if doc is None else doc
     if not isinstance(doc, dict):
         raise ConfigError(f'{yaml_path}: expected a mapping at the top level')
@@ -284,7 +292,7 @@ def load_topic_config(yaml_path: str | Path, channel: str, *,
                               f'{where}; known: {sorted(_KEYS)}')
         merged.update({k: v for k, v in section.items() if k in _KEYS})
 
-    stray = [k for k, v in doc.items() if k != 'topics' and not _holds_node_section(v)]
+    stray = [k for k, v in doc.items() if k != 'topics' and not _node_sections({k: v})]
     if stray:
         raise ConfigError(f'{yaml_path}: unknown top-level key(s) {sorted(map(str, stray))}: '
                           'a params file holds a topics: mapping or ROS node sections '

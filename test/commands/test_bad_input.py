@@ -187,6 +187,9 @@ CASES = [
                                      str(_touch(d / 'f') / 'r.json')], 'not a folder'),
     ('params-out-is-a-folder', lambda d: [str(write_csv(d / 'ok15.csv')), '--params-out',
                                           str(d)], 'a folder'),
+    # identify writes three figures: a figure's file name is refused, no folder x.png made
+    ('plot-names-a-figure-file', lambda d: [str(write_csv(d / 'ok16.csv')), '--plot',
+                                            str(d / 'loops.png')], 'give a folder name'),
 ]
 
 

@@ -193,6 +193,12 @@ def test_a_set_of_an_actuator_outside_4_20_brings_its_command_limits(ros_domain,
     with pytest.raises(ConfigError, match='finite min < max'):
         write_compensator_params({'params': dict(PAPER)}, tmp_path / 'x.yaml',
                                  command_limits=(1.0, 1.0))
+    with pytest.raises(ConfigError, match='got 4 values'):
+        write_compensator_params({'params': dict(PAPER)}, tmp_path / 'y.yaml',
+                                 command_limits=(0.0, 5.0, 1.0, 2.0))
+    two = write_compensator_params({'params': dict(PAPER)}, tmp_path / 'z.yaml',
+                                   command_limits=(0.0, 5.0))   # limits, no first command
+    assert 'max_command: 5.0' in two.read_text() and 'initial_command' not in two.read_text()
     assert read_compensator_params(path)['m_l'] == PAPER['m_l']
     context = rclpy.Context()
     rclpy.init(args=['--ros-args', '--params-file', str(path)], context=context)
