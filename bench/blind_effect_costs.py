@@ -30,9 +30,14 @@ blind run already has: the two must agree.
 Writes ``docs/data/blind_effect_costs.json`` (``{index: {effect: cost}}``),
 which ``blind_family.py`` reads for its per-effect figures.
 
+With ``--clean`` it draws every recording with effects again without any and
+writes ``docs/data/blind_clean_costs.json`` (``{index: cost}``): where the
+chain alone misses the held-out part, the split costs it that much without
+any effect (:func:`clean_figures`; about 10 minutes).
+
 Usage (repository root, about 15 minutes on 2 cores)::
 
-    python bench/blind_effect_costs.py [--n 180] [--workers 2] [--check 4]
+    python bench/blind_effect_costs.py [--n 180] [--workers 2] [--check 4] [--clean]
 """
 
 from __future__ import annotations
@@ -43,11 +48,15 @@ import json
 from pathlib import Path
 import sys
 import time
+from typing import Callable
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from blind_family import draw, ROOT  # noqa: E402, I100
 
 OUT = ROOT / 'docs' / 'data' / 'blind_effect_costs.json'
+CLEAN_OUT = ROOT / 'docs' / 'data' / 'blind_clean_costs.json'
+#: A clean draw whose baseline stays within this many x the floor: the split can judge it.
+CLEAN_OK = 1.5
 
 
 def alone_figures(rows: list[dict], effects: tuple[str, ...]) -> str:
@@ -66,7 +75,7 @@ def alone_figures(rows: list[dict], effects: tuple[str, ...]) -> str:
         return ''
 
     def alone(r: dict, e: str) -> float:
-        return r['cost'] if len(r['effects']) == 1 else costs[str(r['index'])][e]
+        return _alone(r, e, costs)
 
     pairs = [(r, e) for r in rows for e in r['effects']]
     big = [(r, e) for r, e in pairs if alone(r, e) > 3.0]
@@ -92,13 +101,85 @@ def alone_figures(rows: list[dict], effects: tuple[str, ...]) -> str:
     return '\n'.join(lines)
 
 
+def _alone(r: dict, effect: str, costs: dict) -> float:
+    """What ``effect`` of blind row ``r`` costs alone: the row's cost, or this script's."""
+    return r['cost'] if len(r['effects']) == 1 else costs[str(r['index'])][effect]
+
+
+def clean_figures(rows: list[dict], right: Callable[[dict], bool]) -> str:
+    """The named-right figure where the chain alone predicts the clean draw; '' without costs.
+
+    A recording's cost is the baseline's judged held-out miss with its effects
+    in; when the same recording drawn without any effect (``--clean``) is
+    missed as well, the split costs the chain that much by itself (the
+    held-out part reaches output levels or loop states the training part
+    never shows, as on some of the reference family's drawn loops), and what
+    the effects cost cannot be read from it.
+    """
+    try:
+        clean = json.loads(CLEAN_OUT.read_text())
+    except (OSError, ValueError):
+        return ''
+    big = [r for r in rows if r['effects'] and r['cost'] > 3.0]
+    if any(str(r['index']) not in clean for r in big):
+        return ''
+    apart = [r for r in big if clean[str(r['index'])] > CLEAN_OK]
+    kept = [r for r in big if clean[str(r['index'])] <= CLEAN_OK]
+    with_effects = [r for r in rows if r['effects']]
+    missed = [r['index'] for r in with_effects if clean[str(r['index'])] > 3.0]
+    beyond = sum(_beyond_training_levels(i) > 0.05 for i in missed)
+    return '\n'.join([
+        'Where the chain alone predicts the clean draw (`python bench/blind_effect_costs.py '
+        '--clean`: every recording with effects drawn again without any, the baseline on '
+        f'each; {len(missed)} of the {len(with_effects)} clean draws are missed by more '
+        f'than 3 x the floor, {beyond} of them with more than 5 % of the held-out '
+        "measurement beyond the training part's levels: there the split asks the chain "
+        'to extrapolate):', '',
+        '| figure | value |', '|---|---|',
+        f'| effects cost > 3 x and the clean draw within {CLEAN_OK} x: every effect named, '
+        f'nothing else | {sum(right(r) for r in kept)}/{len(kept)} |',
+        f'| effects cost > 3 x but the clean draw is missed by more than {CLEAN_OK} x '
+        f"(the cost is partly the split's) | {len(apart)}: "
+        + ', '.join(f"#{r['index']} ({r['cost']:.1f} x, clean {clean[str(r['index'])]:.1f} x)"
+                    for r in apart) + ' |'] + _both_refinements(rows, clean))
+
+
+def _both_refinements(rows: list[dict], clean: dict) -> list[str]:
+    """Rows of effects costed alone, on recordings whose clean draw the chain predicts."""
+    try:
+        costs = json.loads(OUT.read_text())
+        pairs = [(r, e) for r in rows if clean.get(str(r['index']), 1e9) <= CLEAN_OK
+                 for e in r['effects'] if _alone(r, e, costs) > 3.0]
+    except (OSError, ValueError, KeyError):
+        return []
+    recs = {r['index']: r for r, _ in pairs}.values()
+    right = [r for r in recs if set(r['found']) <= set(r['effects'])
+             and all(e in r['found'] for e in r['effects'] if _alone(r, e, costs) > 3.0)]
+    return [f'| effects that alone cost > 3 x, on recordings whose clean draw is within '
+            f'{CLEAN_OK} x: named | {sum(e in r["found"] for r, e in pairs)}/{len(pairs)} |',
+            '| those recordings: every such effect named, no finding that is not an effect | '
+            f'{len(right)}/{len(recs)} |']
+
+
+def _beyond_training_levels(index: int, train_fraction: float = 0.7) -> float:
+    """Share of the clean draw's held-out measurement beyond its training levels (1 % margin)."""
+    y = draw(index, only=frozenset())['measurement']
+    n = int(round(train_fraction * y.size))
+    lo, hi = float(y[:n].min()), float(y[:n].max())
+    margin = 0.01 * (hi - lo)
+    return float(((y[n:] > hi + margin) | (y[n:] < lo - margin)).mean())
+
+
 def alone_cost(index: int, effect: str) -> tuple[int, str, float]:
-    """The judged baseline held-out %e_r over the floor of ``index`` with ``effect`` only."""
+    """The judged baseline held-out %e_r over the floor of ``index`` with ``effect`` only.
+
+    ``effect`` ``''``: none of its effects (the recording's clean draw).
+    """
     from hyst_id.diagnosis import diagnose, DiagnoseSettings
     from hyst_id.io.recording import Recording
-    case = draw(index, only=frozenset({effect}))
+    case = draw(index, only=frozenset({effect} - {''}))
     rec = Recording(case['t'], case['command'], case['measurement'], case['channel'],
-                    source=f'blind #{index}, {effect} only')
+                    source=f'blind #{index}, {effect or "no effect"} only')
     d = diagnose(rec, settings=DiagnoseSettings(workers=1, max_mechanisms=0))
     j = d.extra['judged_holdout']
     return index, effect, j['baseline_er_percent'] / j['noise_floor_percent']
@@ -110,13 +191,22 @@ def main() -> int:
     ap.add_argument('--workers', type=int, default=2)
     ap.add_argument('--check', type=int, default=4,
                     help='one-effect recordings costed again, against the blind run')
+    ap.add_argument('--clean', action='store_true',
+                    help='instead: every recording with effects drawn again without any '
+                         '(what the split costs the chain alone); checks on clean recordings')
     args = ap.parse_args()
     blind = {r['index']: r for r in json.loads(
         (ROOT / 'docs' / 'diagnosis_blind.json').read_text())}
     cases = [draw(i) for i in range(args.n)]
-    tasks = [(c['index'], e) for c in cases if len(c['effects']) == 2 for e in c['effects']]
-    checks = [(c['index'], c['effects'][0]) for c in cases
-              if len(c['effects']) == 1 and c['index'] in blind][:args.check]
+    if args.clean:
+        tasks = [(c['index'], '') for c in cases if c['effects']]
+        checks = [(c['index'], '') for c in cases
+                  if not c['effects'] and c['index'] in blind][:args.check]
+    else:
+        tasks = [(c['index'], e) for c in cases if len(c['effects']) == 2
+                 for e in c['effects']]
+        checks = [(c['index'], c['effects'][0]) for c in cases
+                  if len(c['effects']) == 1 and c['index'] in blind][:args.check]
     costs: dict[str, dict[str, float]] = {}
     disagree, t0 = 0, time.time()
     with ProcessPoolExecutor(max_workers=args.workers) as pool:
@@ -129,14 +219,18 @@ def main() -> int:
                 disagree += abs(cost - blind[i]['cost']) > 1e-6 * blind[i]['cost']
                 continue
             costs.setdefault(str(i), {})[e] = cost
-            print(f'[{k}/{len(futures)} {time.time() - t0:.0f} s] #{i} {e} alone: '
-                  f'{cost:.2f} x (with both: {blind[i]["cost"]:.2f} x)', flush=True)
+            print(f'[{k}/{len(futures)} {time.time() - t0:.0f} s] #{i} {e or "no effect"} '
+                  f'alone: {cost:.2f} x (with its effects: {blind[i]["cost"]:.2f} x)',
+                  flush=True)
     if disagree:
         print(f'{disagree} check(s) disagree with the blind run: the procedure is not the '
               "blind run's (another code or machine?); nothing written")
         return 1
-    OUT.write_text(json.dumps({k: costs[k] for k in sorted(costs, key=int)}, indent=1) + '\n')
-    print(f'wrote {OUT.relative_to(ROOT)}')
+    out = CLEAN_OUT if args.clean else OUT
+    if args.clean:
+        costs = {k: v[''] for k, v in costs.items()}
+    out.write_text(json.dumps({k: costs[k] for k in sorted(costs, key=int)}, indent=1) + '\n')
+    print(f'wrote {out.relative_to(ROOT)}')
     return 0
 
 

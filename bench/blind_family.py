@@ -286,9 +286,11 @@ def summary(rows: list[dict], how: str = 'one worker each') -> str:
         lo = [r for r in has if r['cost'] <= 3.0]
         lines.append(f'| {e} | {len(has)} | {len(hi)} | {sum(e in r["found"] for r in hi)} | '
                      f'{sum(e in r["found"] for r in lo)}/{len(lo)} |')
-    from blind_effect_costs import alone_figures    # its costs, when written
+    from blind_effect_costs import alone_figures, clean_figures    # its costs, when written
     alone = alone_figures(rows, (*EFFECTS, 'friction'))
     lines += ['', alone] if alone else []
+    clean_split = clean_figures(rows, _right)
+    lines += ['', clean_split] if clean_split else []
     lines += ['', blocked_tally(rows)]
     wrong = [r for r in big if not _right(r)]
     lines += ['', 'Misses where the effects cost > 3 x the floor:', '']
