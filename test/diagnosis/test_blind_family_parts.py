@@ -115,3 +115,41 @@ def test_the_blocked_tally_splits_findings_by_whether_they_are_effects():
     assert 'findings: 0: 1, 1: 1)' in text
     assert 'not an effect not confirmed 1/2' in text
     assert 'not in these rows' in blind_family.blocked_tally(rows[3:])
+
+
+def test_the_clean_draw_figures_set_apart_what_the_split_costs_the_chain(tmp_path,
+                                                                         monkeypatch):
+    """Recordings whose clean draw the chain misses are set apart; the rest scored per effect."""
+    import blind_effect_costs as costs
+    rows = [{**fake_row(i), 'effects': e, 'found': f, 'cost': c}
+            for i, e, f, c in ((0, ['a'], ['a'], 9.0),           # judgeable, right
+                               (1, ['a', 'b'], ['a'], 9.0),      # b costs little alone
+                               (2, ['a'], [], 9.0),              # the clean draw is missed
+                               (3, ['b'], [], 2.0),              # costs <= 3 x: not counted
+                               (4, [], [], 1.0))]                # clean: not drawn again
+    clean = {'0': 1.0, '1': 1.2, '2': 8.0, '3': 1.0}
+    (tmp_path / 'clean.json').write_text(json.dumps(clean))
+    (tmp_path / 'alone.json').write_text(json.dumps({'1': {'a': 9.0, 'b': 1.1}}))
+    monkeypatch.setattr(costs, 'CLEAN_OUT', tmp_path / 'clean.json')
+    monkeypatch.setattr(costs, 'OUT', tmp_path / 'alone.json')
+    monkeypatch.setattr(costs, '_beyond_training_levels', lambda index: 0.0)
+    text = costs.clean_figures(rows, blind_family._right)
+    assert '1 of the 4 clean draws are missed by more than 3 x' in text
+    assert 'clean draw within 1.5 x: every effect named, nothing else | 1/2 |' in text
+    assert '| 1: #2 (9.0 x, clean 8.0 x) |' in text
+    assert 'within 1.5 x: named | 2/2 |' in text        # a in #0 and a in #1; b alone 1.1 x
+    assert 'no finding that is not an effect | 2/2 |' in text
+    (tmp_path / 'clean.json').write_text(json.dumps({'0': 1.0}))      # #1, #2 not costed
+    assert costs.clean_figures(rows, blind_family._right) == ''
+
+
+def test_a_draw_without_its_effects_keeps_everything_else():
+    """``draw(i, only=frozenset())``: the same command and chain, no effect applied."""
+    with_effects = blind_family.draw(138)
+    clean = blind_family.draw(138, only=frozenset())
+    assert with_effects['effects'] and not clean['effects']
+    assert (clean['command'] == with_effects['command']).all()
+    assert clean['chain_params'] == with_effects['chain_params']
+    assert not (clean['measurement'] == with_effects['measurement']).all()
+    assert (blind_family.draw(2, only=frozenset())['measurement']
+            == blind_family.draw(2)['measurement']).all()       # #2 is clean: the same bits
