@@ -31,7 +31,8 @@ Writes ``docs/data/blind_effect_costs.json`` (``{index: {effect: cost}}``),
 which ``blind_family.py`` reads for its per-effect figures.
 
 With ``--clean`` it draws every recording with effects again without any and
-writes ``docs/data/blind_clean_costs.json`` (``{index: cost}``): where the
+writes ``docs/data/blind_clean_costs.json`` (``{"cost": {index: cost}, "train":
+{index: the training fit over its floor}}``): where the
 chain alone misses the held-out part, the split costs it that much without
 any effect (:func:`clean_figures`; about 10 minutes).
 
@@ -117,8 +118,9 @@ def clean_figures(rows: list[dict], right: Callable[[dict], bool]) -> str:
     the effects cost cannot be read from it.
     """
     try:
-        clean = json.loads(CLEAN_OUT.read_text())
-    except (OSError, ValueError):
+        doc = json.loads(CLEAN_OUT.read_text())
+        clean, train = doc['cost'], doc['train']
+    except (OSError, ValueError, KeyError, TypeError):
         return ''
     big = [r for r in rows if r['effects'] and r['cost'] > 3.0]
     if any(str(r['index']) not in clean for r in big):
@@ -128,13 +130,16 @@ def clean_figures(rows: list[dict], right: Callable[[dict], bool]) -> str:
     with_effects = [r for r in rows if r['effects']]
     missed = [r['index'] for r in with_effects if clean[str(r['index'])] > 3.0]
     beyond = sum(_beyond_training_levels(i) > 0.05 for i in missed)
+    unfit = [i for i in missed if train[str(i)] > CLEAN_OK]
     return '\n'.join([
         'Where the chain alone predicts the clean draw (`python bench/blind_effect_costs.py '
         '--clean`: every recording with effects drawn again without any, the baseline on '
         f'each; {len(missed)} of the {len(with_effects)} clean draws are missed by more '
         f'than 3 x the floor, {beyond} of them with more than 5 % of the held-out '
         "measurement beyond the training part's levels: there the split asks the chain "
-        'to extrapolate):', '',
+        f'to extrapolate; {len(missed) - len(unfit)} of the {len(missed)} fit their training '
+        f'part within {CLEAN_OK} x its floor, the baseline stops above it on '
+        + (', '.join(f'#{i} ({train[str(i)]:.2f} x)' for i in unfit) or 'none') + '):', '',
         '| figure | value |', '|---|---|',
         f'| effects cost > 3 x and the clean draw within {CLEAN_OK} x: every effect named, '
         f'nothing else | {sum(right(r) for r in kept)}/{len(kept)} |',
@@ -170,10 +175,11 @@ def _beyond_training_levels(index: int, train_fraction: float = 0.7) -> float:
     return float(((y[n:] > hi + margin) | (y[n:] < lo - margin)).mean())
 
 
-def alone_cost(index: int, effect: str) -> tuple[int, str, float]:
+def alone_cost(index: int, effect: str) -> tuple[int, str, float, float]:
     """The judged baseline held-out %e_r over the floor of ``index`` with ``effect`` only.
 
-    ``effect`` ``''``: none of its effects (the recording's clean draw).
+    ``effect`` ``''``: none of its effects (the recording's clean draw). Also
+    returns the baseline's training %e_r over the training part's floor.
     """
     from hyst_id.diagnosis import diagnose, DiagnoseSettings
     from hyst_id.io.recording import Recording
@@ -182,7 +188,8 @@ def alone_cost(index: int, effect: str) -> tuple[int, str, float]:
                     source=f'blind #{index}, {effect or "no effect"} only')
     d = diagnose(rec, settings=DiagnoseSettings(workers=1, max_mechanisms=0))
     j = d.extra['judged_holdout']
-    return index, effect, j['baseline_er_percent'] / j['noise_floor_percent']
+    return (index, effect, j['baseline_er_percent'] / j['noise_floor_percent'],
+            d.baseline.er_train_percent / d.noise_floor_train_percent)
 
 
 def main() -> int:
@@ -208,17 +215,19 @@ def main() -> int:
         checks = [(c['index'], c['effects'][0]) for c in cases
                   if len(c['effects']) == 1 and c['index'] in blind][:args.check]
     costs: dict[str, dict[str, float]] = {}
+    train_fit: dict[str, float] = {}         # --clean: the training fit over its floor
     disagree, t0 = 0, time.time()
     with ProcessPoolExecutor(max_workers=args.workers) as pool:
         futures = [pool.submit(alone_cost, i, e) for i, e in tasks + checks]
         for k, fut in enumerate(as_completed(futures), 1):
-            i, e, cost = fut.result()
+            i, e, cost, train = fut.result()
             if (i, e) in checks:
                 print(f'check #{i} {e}: alone {cost:.3f} x, blind run {blind[i]["cost"]:.3f} x',
                       flush=True)
                 disagree += abs(cost - blind[i]['cost']) > 1e-6 * blind[i]['cost']
                 continue
             costs.setdefault(str(i), {})[e] = cost
+            train_fit[str(i)] = train
             print(f'[{k}/{len(futures)} {time.time() - t0:.0f} s] #{i} {e or "no effect"} '
                   f'alone: {cost:.2f} x (with its effects: {blind[i]["cost"]:.2f} x)',
                   flush=True)
@@ -228,8 +237,11 @@ def main() -> int:
         return 1
     out = CLEAN_OUT if args.clean else OUT
     if args.clean:
-        costs = {k: v[''] for k, v in costs.items()}
-    out.write_text(json.dumps({k: costs[k] for k in sorted(costs, key=int)}, indent=1) + '\n')
+        doc = {'cost': {k: costs[k][''] for k in sorted(costs, key=int)},
+               'train': {k: train_fit[k] for k in sorted(train_fit, key=int)}}
+    else:
+        doc = {k: costs[k] for k in sorted(costs, key=int)}
+    out.write_text(json.dumps(doc, indent=1) + '\n')
     print(f'wrote {out.relative_to(ROOT)}')
     return 0
 

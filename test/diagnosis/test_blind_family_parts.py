@@ -128,18 +128,22 @@ def test_the_clean_draw_figures_set_apart_what_the_split_costs_the_chain(tmp_pat
                                (3, ['b'], [], 2.0),              # costs <= 3 x: not counted
                                (4, [], [], 1.0))]                # clean: not drawn again
     clean = {'0': 1.0, '1': 1.2, '2': 8.0, '3': 1.0}
-    (tmp_path / 'clean.json').write_text(json.dumps(clean))
+    train = {'0': 1.0, '1': 1.0, '2': 2.5, '3': 1.0}       # #2's training fit stopped above
+    (tmp_path / 'clean.json').write_text(json.dumps({'cost': clean, 'train': train}))
     (tmp_path / 'alone.json').write_text(json.dumps({'1': {'a': 9.0, 'b': 1.1}}))
     monkeypatch.setattr(costs, 'CLEAN_OUT', tmp_path / 'clean.json')
     monkeypatch.setattr(costs, 'OUT', tmp_path / 'alone.json')
     monkeypatch.setattr(costs, '_beyond_training_levels', lambda index: 0.0)
     text = costs.clean_figures(rows, blind_family._right)
     assert '1 of the 4 clean draws are missed by more than 3 x' in text
+    assert '0 of the 1 fit their training part within 1.5 x' in text and '#2 (2.50 x)' in text
     assert 'clean draw within 1.5 x: every effect named, nothing else | 1/2 |' in text
     assert '| 1: #2 (9.0 x, clean 8.0 x) |' in text
     assert 'within 1.5 x: named | 2/2 |' in text        # a in #0 and a in #1; b alone 1.1 x
     assert 'no finding that is not an effect | 2/2 |' in text
-    (tmp_path / 'clean.json').write_text(json.dumps({'0': 1.0}))      # #1, #2 not costed
+    (tmp_path / 'clean.json').write_text(json.dumps({'cost': {'0': 1.0}, 'train': {'0': 1.0}}))
+    assert costs.clean_figures(rows, blind_family._right) == ''       # #1, #2 not costed
+    (tmp_path / 'clean.json').write_text(json.dumps(clean))          # the format before 'train'
     assert costs.clean_figures(rows, blind_family._right) == ''
 
 
