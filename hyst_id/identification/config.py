@@ -25,14 +25,14 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 from hyst_id.errors import ConfigError
-from hyst_id.identification.chains import ChainSpec
+from hyst_id.identification.chains import chain_spec, ChainSpec
 from hyst_id.identification.domains import AUTO, domains_from_data, preset_spec, PRESETS
 from hyst_id.identification.result import IdentifySettings
 from hyst_id.io.params_file import read_yaml
 from hyst_id.io.recording import Recording
 from hyst_id.models.registry import DEFAULT_FAMILY, get_family
 
-__all__ = ['make_settings', 'make_spec', 'read_domains_file']
+__all__ = ['check_domains_file', 'make_settings', 'make_spec', 'read_domains_file']
 
 
 def make_settings(*, seeds: int = 10, seed_offset: int = 0, pop_size: int = 10,
@@ -79,6 +79,26 @@ def read_domains_file(path: str) -> dict[str, tuple[float, float]]:
         return {str(k): (float(v[0]), float(v[1])) for k, v in data.items()}
     except (TypeError, ValueError, IndexError):
         raise ConfigError(f'domains file {path}: each entry must be [low, high]') from None
+
+
+def check_domains_file(path: str, channel: str, family: str | None = None) -> None:
+    """Check a domains file before a recording exists: readable, known names, low < high.
+
+    What :func:`make_spec` would refuse later, said when the file is named
+    (a node's ``domains`` parameter), not after a run was collected.
+
+    Raises
+    ------
+    ConfigError
+        The file cannot be read, names a parameter the ``channel``'s chain of
+        ``family`` does not have, or an entry is not ``[low, high]`` with
+        finite ``low < high``.
+    """
+    try:
+        chain_spec(channel, read_domains_file(path), family=family)
+    except ConfigError as exc:
+        text = str(exc)
+        raise ConfigError(text if str(path) in text else f'domains file {path}: {text}') from None
 
 
 def make_spec(rec: Recording, domains: str | Mapping = AUTO,

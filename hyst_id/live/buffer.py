@@ -22,6 +22,8 @@ does (:func:`hyst_id.io.streams.pair_streams`).
 from __future__ import annotations
 
 import bisect
+from dataclasses import replace
+import math
 import time
 
 import numpy as np
@@ -37,7 +39,9 @@ class SampleBuffer:
 
     Samples may arrive in any order (they are sorted when the recording is
     built). At most ``max_samples`` of each stream are kept (the oldest are
-    dropped, in blocks of a tenth).
+    dropped, in blocks of a tenth). A NaN or infinite value is not kept (one
+    bad reading would make the whole run unidentifiable): it is counted in
+    :attr:`non_finite` and named in the recording's notes.
     """
 
     #: Samples before a window's bisected start that are also looked at (late arrivals).
@@ -54,19 +58,36 @@ class SampleBuffer:
         self.meas_t: list[int] = []
         self.meas_v: list[float] = []
         self.last_rx: float | None = None
+        #: Samples of each stream dropped on arrival for a NaN or infinite value.
+        self.non_finite = {'command': 0, 'measurement': 0}
 
-    def add_command(self, t_ns: int, value: float) -> None:
-        """Append a command sample."""
+    def add_command(self, t_ns: int, value: float) -> bool:
+        """Append a command sample; False (not kept, counted) for a NaN or infinite value."""
+        if not math.isfinite(value):
+            self.non_finite['command'] += 1
+            return False
         self.cmd_t.append(int(t_ns))
         self.cmd_v.append(float(value))
         self._trim(self.cmd_t, self.cmd_v)
+        return True
 
-    def add_measurement(self, t_ns: int, value: float) -> None:
-        """Append a measurement sample."""
+    def add_measurement(self, t_ns: int, value: float) -> bool:
+        """Append a measurement sample; False (not kept, counted) for a NaN or infinite value."""
+        self.last_rx = time.monotonic()
+        if not math.isfinite(value):
+            self.non_finite['measurement'] += 1
+            return False
         self.meas_t.append(int(t_ns))
         self.meas_v.append(float(value))
         self._trim(self.meas_t, self.meas_v)
-        self.last_rx = time.monotonic()
+        return True
+
+    @property
+    def non_finite_note(self) -> str:
+        """Words for the samples dropped for a NaN or infinite value ('' when none)."""
+        dropped = [f'{n} {stream}' for stream, n in self.non_finite.items() if n]
+        return (f'{" and ".join(dropped)} sample(s) with a NaN or infinite value were not '
+                'collected' if dropped else '')
 
     def _trim(self, t: list, v: list) -> None:
         if len(t) > self.max_samples + self.max_samples // 10:
@@ -119,4 +140,6 @@ class SampleBuffer:
             if before.size:                 # the command in effect when the window opens
                 lead[before[np.argmax(ct[before])]] = True
             ct, cv = ct[lead], cv[lead]
-        return pair_streams(ct, cv, mt, mv, channel, source, units, names)
+        rec = pair_streams(ct, cv, mt, mv, channel, source, units, names)
+        note = self.non_finite_note
+        return replace(rec, notes=(*rec.notes, note)) if note else rec

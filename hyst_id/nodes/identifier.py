@@ -80,7 +80,7 @@ from hyst_id.nodes.support import (
     stamp_ns,
 )
 from hyst_id.nodes.support.identifier_params import (
-    default_params_out, identify_settings, PARAMS)
+    default_params_out, identify_settings, PARAMS, validate_identifier_params)
 from hyst_id.nodes.support.result_pub import ResultPublisher
 from hyst_id.nodes.support.sliding import SlidingLink
 
@@ -177,17 +177,7 @@ class Identifier(HystNode):
 
     # ---------------------------------------------------------------- params
     def validate_params(self, values: dict[str, Any], changed: set[str]) -> str | None:
-        dom = values['domains']
-        if 'domains' in changed and dom not in ('auto', 'paper') \
-                and not Path(dom).expanduser().is_file():
-            return f"domains must be 'auto', 'paper' or an existing YAML file; got {dom!r}"
-        if {'domains', 'model'} & changed and dom != 'auto' and values['model'] == 'auto':
-            return "model 'auto' derives each family's domains from the data: domains must be auto"
-        if {'domains', 'model'} & changed and dom == 'paper' and values['model'] != 'tk':
-            return f"the 'paper' domains are for model 'tk', not {values['model']!r}"
-        if any(n.startswith('sliding.') for n in changed):
-            return SlidingLink.validate(values)
-        return None
+        return validate_identifier_params(values, changed)
 
     def apply_params(self, values: dict[str, Any], changed: set[str]) -> None:
         self._requested |= {n for n in _TRIGGERS if n in changed and values[n]}
@@ -204,8 +194,9 @@ class Identifier(HystNode):
 
     def _on_command(self, msg: Any, info: dict) -> None:
         self._rx['command'] = time.monotonic()
-        if self.p('collect'):
-            self.buffer.add_command(self._stamp(msg, info), get_field(msg, self._cmd_field))
+        if self.p('collect') and not self.buffer.add_command(
+                self._stamp(msg, info), float(get_field(msg, self._cmd_field))):
+            self._non_finite()
 
     def _on_measurement(self, msg: Any, info: dict) -> None:
         self._rx['measurement'] = time.monotonic()
@@ -217,8 +208,13 @@ class Identifier(HystNode):
             self.get_logger().warning(f'{self._meas_topic}: cannot read the measurement '
                                       f'field ({exc})', throttle_duration_sec=5.0)
             return
-        self.buffer.add_measurement(self._stamp(msg, info), value)
+        if not self.buffer.add_measurement(self._stamp(msg, info), value):
+            self._non_finite()
         self._eor_tried = False
+
+    def _non_finite(self) -> None:
+        self.get_logger().warning(self.buffer.non_finite_note + ' (not collected)',
+                                  throttle_duration_sec=5.0)
 
     # ------------------------------------------------------------ requests
     def _on_trigger(self, fn: Callable[[str], tuple[bool, str]], response: Any) -> Any:
@@ -254,12 +250,11 @@ class Identifier(HystNode):
             else:
                 spec = make_spec(rec, self.p('domains'), family=model)
                 self.job = IdentificationJob(rec, spec, self.settings())
-        except HystIdError as exc:
-            self._fail(f'cannot identify ({why}): {exc}; {self._kept()}')
+        except HystIdError as exc:     # the samples stay (mend the cause, identify_now)
+            self._fail(f'cannot identify ({why}): {exc}; {self._kept()}; the {n} samples kept')
             return False, str(exc)
-        finally:
-            if self.p('clear_after_identify'):
-                self.buffer.clear()
+        if self.p('clear_after_identify'):
+            self.buffer.clear()
         for note in rec.notes:
             self.get_logger().warning(f'samples: {note}')
         s = self.job.settings
@@ -482,8 +477,8 @@ class Identifier(HystNode):
                 msg += f'; hopping {prog["hop"]}/{prog["hops"]}'
         elif self.last_error:
             level, msg = 2, self.last_error
-        elif self._gate_message:
-            level, msg = 1, self._gate_message
+        elif self._gate_message or self.buffer.non_finite_note:
+            level, msg = 1, self._gate_message or f'{msg}; {self.buffer.non_finite_note}'
         elif self.last_document:
             values['last_er_percent'] = self.last_document.get('er_percent') or math.nan
             if self.last_document.get('warnings'):     # the set's warnings stay visible

@@ -136,6 +136,11 @@ class Replay(HystNode):
                 break
             self._stop.wait(0.05)
         self._stop.wait(self.p('start_delay_s'))
+        alone = [t for t, pub in self._pubs.items() if pub.get_subscription_count() == 0]
+        if alone and not self._stop.is_set():
+            self.get_logger().warning(
+                f'nothing subscribes to {", ".join(alone)} yet: what is played before a '
+                'subscriber is matched is lost (wait_for_subscribers:=N waits for N)')
 
     def _run(self) -> None:
         try:

@@ -124,6 +124,40 @@ def test_a_gap_too_long_for_one_run_is_refused_and_the_last_set_stays(ctx, tmp_p
     assert ident.last_document['er_percent'] == 0.5 and out.read_bytes() == before
 
 
+def test_a_refused_run_keeps_its_samples_and_non_finite_ones_are_not_collected(ctx, tmp_path):
+    """A NaN is dropped on arrival (counted, a WARN); a run refused keeps what was collected."""
+    ident = _make(ctx, Identifier, parameter_overrides=FAST + [Parameter('min_samples',
+                                                                         value=50)])
+    stamps, v, y = _samples()
+    y = y.copy()
+    y[150] = np.nan
+    _feed(ident, stamps, v, y)
+    assert ident.buffer.n_measurements == 399 and ident.buffer.non_finite['measurement'] == 1
+    assert '1 measurement sample(s) with a NaN' in ident.collected_recording().notes[-1]
+    ident.buffer.clear()
+    _feed(ident, stamps, np.full(400, 9.0), y)              # no excitation: refused
+    ok, message = ident.request_identification('test')
+    assert not ok and 'samples kept' in ident.last_error, ident.last_error
+    assert ident.buffer.n_measurements == 399               # not cleared: nothing lost
+
+
+def test_a_bad_compensator_node_or_domains_file_is_refused_when_set(ctx, tmp_path):
+    ident = _make(ctx, Identifier, parameter_overrides=FAST)
+    res = ident.set_parameters([Parameter('compensator_node', value='bad name!')])[0]
+    assert not res.successful and 'not a valid node name' in res.reason
+    assert ident.set_parameters([Parameter('compensator_node', value='/v1/compensator')])[
+        0].successful
+    bad = tmp_path / 'dom.yaml'
+    bad.write_text('m_l: [0.1, 0.5]\nnot_a_parameter: [0, 1]\n')
+    res = ident.set_parameters([Parameter('domains', value=str(bad))])[0]
+    assert not res.successful and 'not_a_parameter' in res.reason, res.reason
+    bad.write_text('m_l: [0.5, 0.1]\n')
+    res = ident.set_parameters([Parameter('domains', value=str(bad))])[0]
+    assert not res.successful and 'low < high' in res.reason, res.reason
+    bad.write_text('m_l: [0.1, 0.5]\n')
+    assert ident.set_parameters([Parameter('domains', value=str(bad))])[0].successful
+
+
 def test_a_failed_identification_keeps_the_last_parameters(ctx, tmp_path, monkeypatch):
     import hyst_id.live.jobs
 

@@ -507,6 +507,20 @@ def test_control_error_percent_is_eq26():
         100 * math.sqrt(0.01 / 5.0))
 
 
+def test_replay_says_when_nothing_subscribes_yet(ctx, tmp_path, monkeypatch):
+    """Without wait_for_subscribers a replay to topics nobody listens to warns (data lost)."""
+    t = np.arange(20) * 0.1
+    bag = write_recording_bag(tmp_path / 'src', Recording(t, 9 + np.sin(t), t, 'position'))
+    said: list[str] = []
+    play = _make(ctx, Replay, parameter_overrides=[
+        Parameter('bag', value=str(bag)), Parameter('rate', value=20.0),
+        Parameter('start_delay_s', value=1.0), Parameter('shutdown_when_done', value=False)])
+    monkeypatch.setattr(play.get_logger(), 'warning', lambda m, **kw: said.append(m))
+    _spin_until(ctx, [play], lambda: bool(said), timeout=10.0)
+    assert said and 'nothing subscribes to' in said[0] and 'wait_for_subscribers' in said[0]
+    assert '/hyst_id/command' in said[0]
+
+
 @pytest.mark.parametrize('sim_time', [True, False])
 def test_replay_clock_keeps_bag_time_at_any_rate(ctx, tmp_path, sim_time):
     """Unstamped commands replayed at rate 4 keep their 0.1 s spacing for a sim-time node."""

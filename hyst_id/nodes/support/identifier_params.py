@@ -20,14 +20,50 @@ import os
 from pathlib import Path
 from typing import Any, Callable
 
-from hyst_id.identification.config import make_settings
+from rclpy.validate_topic_name import InvalidServiceNameException, validate_topic_name
+
+from hyst_id.errors import ConfigError
+from hyst_id.identification.config import check_domains_file, make_settings
 from hyst_id.identification.result import IdentifySettings
 from hyst_id.io.recording import CHANNELS
 from hyst_id.nodes.support.params import field_params, Param, topic_params
 from hyst_id.nodes.support.qos import IDENTIFIED_PARAMS_TOPIC
-from hyst_id.nodes.support.sliding import SLIDING_PARAMS
+from hyst_id.nodes.support.sliding import SLIDING_PARAMS, SlidingLink
 
-__all__ = ['PARAMS', 'default_params_out', 'identify_settings']
+__all__ = ['PARAMS', 'default_params_out', 'identify_settings', 'validate_identifier_params']
+
+
+def validate_identifier_params(values: dict[str, Any], changed: set[str]) -> str | None:
+    """Why the identifier's parameter ``values`` cannot be taken, or None.
+
+    Checked when set, not when a run has been collected: the domains (and a
+    domains file's contents, against the channel's chain of the model's
+    family), the compensator's node name (its service name must be valid),
+    and the sliding re-identification's settings.
+    """
+    dom = values['domains']
+    if {'domains', 'model'} & changed and dom != 'auto' and values['model'] == 'auto':
+        return "model 'auto' derives each family's domains from the data: domains must be auto"
+    if {'domains', 'model'} & changed and dom == 'paper' and values['model'] != 'tk':
+        return f"the 'paper' domains are for model 'tk', not {values['model']!r}"
+    if {'domains', 'model'} & changed and dom not in ('auto', 'paper'):
+        if not Path(dom).expanduser().is_file():
+            return f"domains must be 'auto', 'paper' or an existing YAML file; got {dom!r}"
+        try:
+            check_domains_file(str(Path(dom).expanduser()), values['channel'], values['model'])
+        except ConfigError as exc:
+            return str(exc)
+    node = values['compensator_node']
+    if 'compensator_node' in changed and node:
+        try:
+            validate_topic_name(node.rstrip('/') + '/set_parameters_atomically',
+                                is_service=True)
+        except InvalidServiceNameException as exc:
+            return (f'compensator_node {node!r} is not a valid node name: '
+                    + str(exc).splitlines()[0])
+    if any(n.startswith('sliding.') for n in changed):
+        return SlidingLink.validate(values)
+    return None
 
 
 def identify_settings(p: Callable[[str], Any]) -> IdentifySettings:

@@ -22,6 +22,7 @@ from typing import Any
 from rcl_interfaces.srv import SetParametersAtomically
 from rclpy.node import Node
 from rclpy.parameter import Parameter
+from rclpy.validate_topic_name import InvalidServiceNameException
 
 __all__ = ['ParameterPusher']
 
@@ -53,7 +54,14 @@ class ParameterPusher:
         if self._client is None or self._client.srv_name != name:
             if self._client is not None:
                 self.node.destroy_client(self._client)
-            self._client = self.node.create_client(SetParametersAtomically, name)
+            try:
+                self._client = self.node.create_client(SetParametersAtomically, name)
+            except (InvalidServiceNameException, ValueError) as exc:
+                self.node.get_logger().error(
+                    f'cannot push the parameters to {name}: {str(exc).splitlines()[0]} (they '
+                    'are on the latched topic and in the params file)')
+                self._client = self._pending = None
+                return
         if not self._client.service_is_ready():
             if time.monotonic() > deadline:
                 self.node.get_logger().warning(
