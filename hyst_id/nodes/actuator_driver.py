@@ -192,12 +192,12 @@ class ActuatorDriver(HystNode):
         # command acts (a stamped command's stamp; else when it arrived: the middleware's
         # receive stamp, free of executor delays) until the next command, so that is the
         # sample's stamp.
-        ns, dt_s = self._command_clock.advance(self._command.acts_at_ns(msg, info, self),
-                                               self.get_logger())
         command = self._command.value(msg)
         if not math.isfinite(command):
-            self.get_logger().warning('ignored a non-finite command', throttle_duration_sec=5.0)
+            self.note_non_finite('command')
             return
+        ns, dt_s = self._command_clock.advance(self._command.acts_at_ns(msg, info, self),
+                                               self.get_logger())
         position = self.actuator.apply(command, dt_s * self.p('time_scale'))
         out = JointState()
         out.header.stamp.sec, out.header.stamp.nanosec = divmod(ns, 1_000_000_000)

@@ -380,8 +380,7 @@ class Compensator(HystNode):
             self.get_logger().error(f'{self._not_sent} command(s) refused by the middleware '
                                     '(a subscriber stalled?)', throttle_duration_sec=1.0)
         if not math.isfinite(desired):
-            self.get_logger().warning('non-finite desired value: holding the last command',
-                                      throttle_duration_sec=5.0)
+            self.note_non_finite('desired value (the last command is held)')
 
     def set_bypass(self, on: bool) -> str:
         """Pass the desired value through (on) or compensate again (off); the reason.
@@ -464,12 +463,14 @@ class Compensator(HystNode):
                   'er_percent': self.p('er_percent'), 'command': self._comp.state[0],
                   'generation': self._generation, 'rejected_updates': self.rejected_updates,
                   'bypass': self._comp.bypass,
-                  'commands_not_sent': self._not_sent, **self._tracking.status()}
+                  'commands_not_sent': self._not_sent, 'non_finite_inputs': self.non_finite_seen,
+                  **self._tracking.status()}
         inputs = [(self.p('topics.desired_topic'), self._desired.type_name)]
         if self._tracking.adaptive is not None:     # the measurement tracking reads
             ch = self.p('channel')
             inputs.append((self.p(f'topics.{ch}_topic'), self.p(f'topics.{ch}_type')))
         wrong = input_problems(self, inputs, {}, 0.0, math.inf, {})
+        wrong += [w for w in [self.non_finite_problem()] if w]
         if wrong:
             text = '; '.join(wrong)
             self.get_logger().error(text, throttle_duration_sec=10.0)

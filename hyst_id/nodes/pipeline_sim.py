@@ -269,7 +269,7 @@ class PipelineSim(HystNode):
     def _on_command(self, msg: Any, info: dict) -> None:
         command = self._command.value(msg)
         if not math.isfinite(command):
-            self.get_logger().warning('ignored a non-finite command', throttle_duration_sec=5.0)
+            self.note_non_finite('command')
             return
         # a stamped command acts at its stamp; an unstamped one when it arrived
         ns, dt_s = self._command_clock.advance(self._command.acts_at_ns(msg, info, self),

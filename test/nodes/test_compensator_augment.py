@@ -111,3 +111,20 @@ def test_a_set_without_its_output_map_is_refused_while_one_is_in_force(ctx):
                                              Parameter('augment.poly_c2', value=0.0)])
     assert result.successful, result.reason
     assert not comp._comp.augmentation.has_output_map
+
+
+def test_a_non_finite_desired_value_holds_the_command_and_reports_an_error(ctx, monkeypatch):
+    """NaN in: the last command is held, and the next /diagnostics status is an ERROR."""
+    comp = _node(ctx)
+    sent: list[tuple[int, str, dict]] = []
+    monkeypatch.setattr(comp, 'publish_diagnostics',
+                        lambda level, msg, values=None, **kw: sent.append((level, msg, values)))
+    comp._on_desired(Float64(data=9.0))
+    held = comp._comp.state[0]
+    comp._on_desired(Float64(data=math.nan))
+    assert comp._comp.state[0] == held and comp.non_finite_seen == 1
+    comp._publish_status()
+    assert sent[-1][0] == 2 and '1 non-finite input value(s)' in sent[-1][1], sent[-1]
+    assert sent[-1][2]['non_finite_inputs'] == 1
+    comp._publish_status()                          # none since: back to the usual status
+    assert sent[-1][0] != 2 or 'non-finite' not in sent[-1][1]

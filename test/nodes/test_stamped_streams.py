@@ -335,3 +335,15 @@ def test_a_command_stamped_before_the_last_moves_no_time():
     # a bag replayed again: the stamp goes back, the plant's time does not
     assert clock.advance(T0_NS, log) == (T0_NS + 250_000_000, 0.0) and len(warned) == 1
     assert clock.advance(T0_NS + 350_000_000, log)[1] == pytest.approx(0.1)
+
+
+def test_a_non_finite_command_is_ignored_and_named_on_diagnostics(ctx):
+    """The driver and the simulated pipeline drop a NaN command; their status says so."""
+    from std_msgs.msg import Float64
+    from hyst_id.nodes.pipeline_sim import PipelineSim
+    for cls in (ActuatorDriver, PipelineSim):
+        node = make_node(ctx, cls)
+        node._on_command(Float64(data=float('nan')), {})
+        assert node.non_finite_seen == 1
+        assert '1 non-finite input value(s)' in node.non_finite_problem()
+        assert node.non_finite_problem() == ''          # said once, the count kept

@@ -105,6 +105,7 @@ class HystNode(Node):
         super().__init__(node_name, **kwargs)
         self._param_table = {p.name: p for p in params}
         self._diag_pub = None
+        self.non_finite_seen, self._non_finite_new = 0, False
         #: Parameter changes rejected since the start.
         self.rejected_updates = 0
         defaults = dict(defaults or {})
@@ -223,6 +224,24 @@ class HystNode(Node):
         arr.status.extend(extra)
         try_publish(self._diag_pub, arr)
 
+    def note_non_finite(self, what: str) -> None:
+        """Count an input value that is NaN or infinite (the caller ignores it); log it.
+
+        The node's next ``/diagnostics`` status is an ERROR naming the count
+        (:meth:`non_finite_problem`).
+        """
+        self.non_finite_seen += 1
+        self._non_finite_new = True
+        self.get_logger().warning(f'ignored a non-finite {what} ({self.non_finite_seen} so '
+                                  'far)', throttle_duration_sec=5.0)
+
+    def non_finite_problem(self) -> str:
+        """Words for non-finite inputs since the last call ('' when none came)."""
+        if not self._non_finite_new:
+            return ''
+        self._non_finite_new = False
+        return f'{self.non_finite_seen} non-finite input value(s) ignored so far (NaN or inf)'
+
     def watch_input_types(self, expected: Sequence[tuple[str, str]],
                           period_s: float = 1.0) -> None:
         """Publish this node's ``/diagnostics`` status every ``period_s``.
@@ -235,6 +254,7 @@ class HystNode(Node):
 
         def check() -> None:
             problems = input_problems(self, expected, {}, started, math.inf, {})
+            problems += [w for w in [self.non_finite_problem()] if w]
             if problems:
                 self.get_logger().error('; '.join(problems), throttle_duration_sec=10.0)
                 self.publish_diagnostics(2, '; '.join(problems))
