@@ -114,7 +114,7 @@ def test_a_set_without_its_output_map_is_refused_while_one_is_in_force(ctx):
 
 
 def test_a_non_finite_desired_value_holds_the_command_and_reports_an_error(ctx, monkeypatch):
-    """NaN in: the last command is held, and the next /diagnostics status is an ERROR."""
+    """A NaN in: the last command is held, and the next /diagnostics status is an ERROR."""
     comp = _node(ctx)
     sent: list[tuple[int, str, dict]] = []
     monkeypatch.setattr(comp, 'publish_diagnostics',
