@@ -273,8 +273,9 @@ class Compensator(HystNode):
                 return f'{", ".join(inf)} must be finite (or .nan for unset)'
             try:
                 kind, _, unset = _model_state(values)
-            except InvalidParametersError as exc:
-                return f'{exc}; keeping the last good set'
+            except InvalidParametersError as exc:     # at startup there is no set to keep
+                running = getattr(self, '_comp', None) is not None
+                return f'{exc}' + ('; keeping the last good set' if running else '')
             if kind == 'incomplete' and getattr(self, '_comp', None) is not None \
                     and self._comp.model is not None:
                 return (f'incomplete {values["family"]} set (unset: {", ".join(unset)}): '

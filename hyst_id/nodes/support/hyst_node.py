@@ -119,7 +119,7 @@ class HystNode(Node):
             except InvalidParameterTypeException as exc:
                 raise ConfigError(
                     f'parameter {p.name} must be {_TYPE_NAMES.get(type(default), "")} '
-                    f'(like {default!r}); the params file gives another type '
+                    f'(like {default!r}); the params file or -p gives another type '
                     f'({first_line(exc)})') from None
             except (InvalidParameterValueException, ParameterException) as exc:
                 raise ConfigError(f'parameter {p.name}: {first_line(exc)}') from None
