@@ -169,8 +169,9 @@ class Identifier(HystNode):
             f'{v[f"topics.{self.channel}_field"]}); publishing on '
             f'{self._result_pub.topic_name}'
             + (f' and {self._result_pub.typed_topic_name}' if self._result_pub.typed_topic_name
-               else '') + '; trigger: end of run after '
-            f'{v["end_of_run_timeout_s"]:g} s idle, identify_now:=true'
+               else '') + '; trigger: '
+            + (f'end of run after {v["end_of_run_timeout_s"]:g} s idle, '
+               if v['end_of_run_timeout_s'] > 0 else '') + 'identify_now:=true'
             + (', ~/identify, ~/cancel, ~/diagnose services' if Trigger is not None else ''))
         if v['recover_on_start'] and self.params_out.is_file():
             self._recover()

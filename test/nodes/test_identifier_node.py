@@ -141,7 +141,7 @@ def test_a_refused_run_keeps_its_samples_and_non_finite_ones_are_not_collected(c
     assert ident.buffer.n_measurements == 399               # not cleared: nothing lost
 
 
-def test_a_bad_compensator_node_or_domains_file_is_refused_when_set(ctx, tmp_path):
+def test_a_bad_compensator_node_domains_file_or_mechanism_is_refused_when_set(ctx, tmp_path):
     ident = _make(ctx, Identifier, parameter_overrides=FAST)
     res = ident.set_parameters([Parameter('compensator_node', value='bad name!')])[0]
     assert not res.successful and 'not a valid node name' in res.reason
@@ -156,6 +156,10 @@ def test_a_bad_compensator_node_or_domains_file_is_refused_when_set(ctx, tmp_pat
     assert not res.successful and 'low < high' in res.reason, res.reason
     bad.write_text('m_l: [0.1, 0.5]\n')
     assert ident.set_parameters([Parameter('domains', value=str(bad))])[0].successful
+    res = ident.set_parameters([Parameter('diagnose_mechanisms', value='dead_time, foo')])[0]
+    assert not res.successful and "unknown mechanism(s) ['foo']" in res.reason, res.reason
+    assert ident.set_parameters([Parameter('diagnose_mechanisms', value='dead_time')])[
+        0].successful
 
 
 def test_a_failed_identification_keeps_the_last_parameters(ctx, tmp_path, monkeypatch):

@@ -22,6 +22,7 @@ from typing import Any, Callable
 
 from rclpy.validate_topic_name import InvalidServiceNameException, validate_topic_name
 
+from hyst_id.diagnosis.mechanisms.registry import get_mechanisms
 from hyst_id.errors import ConfigError
 from hyst_id.identification.config import check_domains_file, make_settings
 from hyst_id.identification.result import IdentifySettings
@@ -38,8 +39,8 @@ def validate_identifier_params(values: dict[str, Any], changed: set[str]) -> str
 
     Checked when set, not when a run has been collected: the domains (and a
     domains file's contents, against the channel's chain of the model's
-    family), the compensator's node name (its service name must be valid),
-    and the sliding re-identification's settings.
+    family), the diagnosis's mechanism ids, the compensator's node name (its
+    service name must be valid), and the sliding re-identification's settings.
     """
     dom = values['domains']
     if {'domains', 'model'} & changed and dom != 'auto' and values['model'] == 'auto':
@@ -53,6 +54,12 @@ def validate_identifier_params(values: dict[str, Any], changed: set[str]) -> str
             check_domains_file(str(Path(dom).expanduser()), values['channel'], values['model'])
         except ConfigError as exc:
             return str(exc)
+    if {'diagnose_mechanisms', 'channel'} & changed and values['diagnose_mechanisms'].strip():
+        try:
+            get_mechanisms([m.strip() for m in values['diagnose_mechanisms'].split(',')
+                            if m.strip()], values['channel'])
+        except ConfigError as exc:
+            return f'diagnose_mechanisms: {exc}'
     node = values['compensator_node']
     if 'compensator_node' in changed and node:
         try:
