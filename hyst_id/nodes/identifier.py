@@ -428,6 +428,8 @@ class Identifier(HystNode):
             + f'; the compensator and {self.params_out} keep their set (relax '
             'gate_max_floor_ratio / gate_max_uncertainty to hand such sets over)')
         self.get_logger().warning(self._gate_message)
+        for w in ident.warnings:        # as for a set handed over
+            self.get_logger().warning(f'identification: {w}')
         self.publish_diagnostics(1, self._gate_message, {'er_percent': ident.er_percent})
         if self.on_identified is not None:
             self.on_identified(doc)
