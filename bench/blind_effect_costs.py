@@ -39,6 +39,9 @@ any effect (:func:`clean_figures`; about 10 minutes).
 Usage (repository root, about 15 minutes on 2 cores)::
 
     python bench/blind_effect_costs.py [--n 180] [--workers 2] [--check 4] [--clean]
+    python bench/blind_effect_costs.py --clean --gaass 10 500 [--summarise]
+        # the clean draws with identify's GAASS settings in the baseline (about 20
+        # minutes), compared with the default run
 """
 
 from __future__ import annotations
@@ -175,21 +178,50 @@ def _beyond_training_levels(index: int, train_fraction: float = 0.7) -> float:
     return float(((y[n:] > hi + margin) | (y[n:] < lo - margin)).mean())
 
 
-def alone_cost(index: int, effect: str) -> tuple[int, str, float, float]:
+def _gaass_out(gaass: list[int]) -> Path:
+    return CLEAN_OUT.with_name(f'{CLEAN_OUT.stem}_s{gaass[0]}g{gaass[1]}.json')
+
+
+def gaass_comparison(path: Path) -> str:
+    """What other GAASS settings in the baseline change on the clean draws (``--gaass``)."""
+    old, new = json.loads(CLEAN_OUT.read_text()), json.loads(path.read_text())
+    keys = sorted(set(old['cost']) & set(new['cost']), key=int)
+    lines = [f'{len(keys)} clean draws, default baseline -> {path.name}:']
+    for name, part in (('held-out cost', 'cost'), ('training fit', 'train')):
+        a = [old[part][k] for k in keys]
+        b = [new[part][k] for k in keys]
+        for limit in (1.5, 3.0):
+            lines.append(f'  {name} > {limit} x: {sum(x > limit for x in a)} -> '
+                         f'{sum(x > limit for x in b)}')
+    worse = [k for k in keys if old['cost'][k] <= 1.5 < new['cost'][k]]
+    better = [k for k in keys if new['cost'][k] <= 1.5 < old['cost'][k]]
+    lines.append('  within 1.5 x now, not before: ' + (', '.join(
+        f"#{k} ({old['cost'][k]:.1f} -> {new['cost'][k]:.2f})" for k in better) or 'none'))
+    lines.append('  within 1.5 x before, not now: ' + (', '.join(
+        f"#{k} ({old['cost'][k]:.2f} -> {new['cost'][k]:.1f})" for k in worse) or 'none'))
+    return '\n'.join(lines)
+
+
+def alone_cost(index: int, effect: str, gaass: tuple[int, int] | None = None
+               ) -> tuple[int, str, float, float, float]:
     """The judged baseline held-out %e_r over the floor of ``index`` with ``effect`` only.
 
     ``effect`` ``''``: none of its effects (the recording's clean draw). Also
-    returns the baseline's training %e_r over the training part's floor.
+    returns the baseline's training %e_r over the training part's floor and the
+    seconds it took. ``gaass``: (seeds, generations) of the baseline's GAASS
+    instead of the diagnosis's defaults.
     """
     from hyst_id.diagnosis import diagnose, DiagnoseSettings
     from hyst_id.io.recording import Recording
     case = draw(index, only=frozenset({effect} - {''}))
     rec = Recording(case['t'], case['command'], case['measurement'], case['channel'],
                     source=f'blind #{index}, {effect or "no effect"} only')
-    d = diagnose(rec, settings=DiagnoseSettings(workers=1, max_mechanisms=0))
+    more = {} if gaass is None else {'seeds': tuple(range(gaass[0])), 'generations': gaass[1]}
+    t0 = time.time()
+    d = diagnose(rec, settings=DiagnoseSettings(workers=1, max_mechanisms=0, **more))
     j = d.extra['judged_holdout']
     return (index, effect, j['baseline_er_percent'] / j['noise_floor_percent'],
-            d.baseline.er_train_percent / d.noise_floor_train_percent)
+            d.baseline.er_train_percent / d.noise_floor_train_percent, time.time() - t0)
 
 
 def main() -> int:
@@ -198,10 +230,18 @@ def main() -> int:
     ap.add_argument('--workers', type=int, default=2)
     ap.add_argument('--check', type=int, default=4,
                     help='one-effect recordings costed again, against the blind run')
+    ap.add_argument('--gaass', type=int, nargs=2, metavar=('SEEDS', 'GENERATIONS'),
+                    help="with --clean: the baseline's GAASS with these settings (identify's: "
+                         '10 500), compared with the default run, written apart')
+    ap.add_argument('--summarise', action='store_true',
+                    help='with --gaass: only compare its written run with the default one')
     ap.add_argument('--clean', action='store_true',
                     help='instead: every recording with effects drawn again without any '
                          '(what the split costs the chain alone); checks on clean recordings')
     args = ap.parse_args()
+    if args.gaass and args.summarise:
+        print(gaass_comparison(_gaass_out(args.gaass)))
+        return 0
     blind = {r['index']: r for r in json.loads(
         (ROOT / 'docs' / 'diagnosis_blind.json').read_text())}
     cases = [draw(i) for i in range(args.n)]
@@ -216,11 +256,15 @@ def main() -> int:
                   if len(c['effects']) == 1 and c['index'] in blind][:args.check]
     costs: dict[str, dict[str, float]] = {}
     train_fit: dict[str, float] = {}         # --clean: the training fit over its floor
-    disagree, t0 = 0, time.time()
+    disagree, t0, times = 0, time.time(), []
     with ProcessPoolExecutor(max_workers=args.workers) as pool:
-        futures = [pool.submit(alone_cost, i, e) for i, e in tasks + checks]
+        if args.gaass:           # other settings: nothing to check against the blind run
+            checks = []
+        futures = [pool.submit(alone_cost, i, e, tuple(args.gaass) if args.gaass else None)
+                   for i, e in tasks + checks]
         for k, fut in enumerate(as_completed(futures), 1):
-            i, e, cost, train = fut.result()
+            i, e, cost, train, seconds = fut.result()
+            times.append(seconds)
             if (i, e) in checks:
                 print(f'check #{i} {e}: alone {cost:.3f} x, blind run {blind[i]["cost"]:.3f} x',
                       flush=True)
@@ -235,7 +279,11 @@ def main() -> int:
         print(f'{disagree} check(s) disagree with the blind run: the procedure is not the '
               "blind run's (another code or machine?); nothing written")
         return 1
+    print(f'baseline seconds per recording (one process each): median '
+          f'{sorted(times)[len(times) // 2]:.1f}, max {max(times):.1f}')
     out = CLEAN_OUT if args.clean else OUT
+    if args.gaass:
+        out = _gaass_out(args.gaass)
     if args.clean:
         doc = {'cost': {k: costs[k][''] for k in sorted(costs, key=int)},
                'train': {k: train_fit[k] for k in sorted(train_fit, key=int)}}

@@ -157,3 +157,18 @@ def test_a_draw_without_its_effects_keeps_everything_else():
     assert not (clean['measurement'] == with_effects['measurement']).all()
     assert (blind_family.draw(2, only=frozenset())['measurement']
             == blind_family.draw(2)['measurement']).all()       # #2 is clean: the same bits
+
+
+def test_the_gaass_comparison_counts_both_ways(tmp_path, monkeypatch):
+    """Clean draws that came within 1.5 x with other GAASS settings, and those that left."""
+    import blind_effect_costs as costs
+    old = {'cost': {'1': 4.0, '2': 1.0, '3': 2.0}, 'train': {'1': 2.0, '2': 1.0, '3': 1.0}}
+    new = {'cost': {'1': 1.2, '2': 1.6, '3': 2.0}, 'train': {'1': 1.0, '2': 1.0, '3': 1.0}}
+    (tmp_path / 'clean.json').write_text(json.dumps(old))
+    (tmp_path / 'clean_s10g500.json').write_text(json.dumps(new))
+    monkeypatch.setattr(costs, 'CLEAN_OUT', tmp_path / 'clean.json')
+    text = costs.gaass_comparison(costs._gaass_out([10, 500]))
+    assert 'held-out cost > 1.5 x: 2 -> 2' in text and 'held-out cost > 3.0 x: 1 -> 0' in text
+    assert 'training fit > 1.5 x: 1 -> 0' in text
+    assert 'within 1.5 x now, not before: #1 (4.0 -> 1.20)' in text
+    assert 'within 1.5 x before, not now: #2 (1.00 -> 1.6)' in text
