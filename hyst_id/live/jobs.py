@@ -28,6 +28,7 @@ import threading
 import time
 from typing import Any
 
+from hyst_id.diagnosis.mechanisms.registry import mechanism_ids
 from hyst_id.errors import HystIdError
 from hyst_id.identification import Identification, identify, IdentifySettings, SeedRun
 from hyst_id.identification.chains import ChainSpec
@@ -217,7 +218,7 @@ class DiagnosisJob(BackgroundJob):
         super().__init__()
         self.rec, self.kwargs = rec, kwargs
         if isinstance(mechanisms, str):
-            mechanisms = tuple(m.strip() for m in mechanisms.split(',') if m.strip())
+            mechanisms = mechanism_ids(mechanisms)
         self.options = {'train_fraction': float(train_fraction),
                         'seeds': tuple(range(int(seeds))), 'generations': int(generations),
                         'mechanisms': tuple(mechanisms) or None, 'hops': int(hops),

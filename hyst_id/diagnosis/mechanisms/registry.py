@@ -39,7 +39,8 @@ from hyst_id.diagnosis.mechanisms import (
 from hyst_id.diagnosis.mechanisms.base import Context, Mechanism, Quantity
 from hyst_id.errors import ConfigError
 
-__all__ = ['MECHANISMS', 'MECHANISM_IDS', 'Context', 'Mechanism', 'Quantity', 'get_mechanisms']
+__all__ = ['MECHANISMS', 'MECHANISM_IDS', 'Context', 'Mechanism', 'Quantity', 'get_mechanisms',
+           'mechanism_ids']
 
 #: Every mechanism by id, in the issue's order.
 MECHANISMS: dict[str, Mechanism] = {m.MECHANISM.id: m.MECHANISM for m in (
@@ -49,6 +50,11 @@ MECHANISMS: dict[str, Mechanism] = {m.MECHANISM.id: m.MECHANISM for m in (
 
 #: The ids alone.
 MECHANISM_IDS = tuple(MECHANISMS)
+
+
+def mechanism_ids(text: str) -> tuple[str, ...]:
+    """Mechanism ids from comma-separated ``text`` (a node parameter); blanks are skipped."""
+    return tuple(m.strip() for m in text.split(',') if m.strip())
 
 
 def get_mechanisms(ids=None, channel: str | None = None) -> list[Mechanism]:

@@ -22,7 +22,7 @@ from typing import Any, Callable
 
 from rclpy.validate_topic_name import InvalidServiceNameException, validate_topic_name
 
-from hyst_id.diagnosis.mechanisms.registry import get_mechanisms
+from hyst_id.diagnosis.mechanisms.registry import get_mechanisms, mechanism_ids
 from hyst_id.errors import ConfigError
 from hyst_id.identification.config import check_domains_file, make_settings
 from hyst_id.identification.result import IdentifySettings
@@ -56,8 +56,7 @@ def validate_identifier_params(values: dict[str, Any], changed: set[str]) -> str
             return str(exc)
     if {'diagnose_mechanisms', 'channel'} & changed and values['diagnose_mechanisms'].strip():
         try:
-            get_mechanisms([m.strip() for m in values['diagnose_mechanisms'].split(',')
-                            if m.strip()], values['channel'])
+            get_mechanisms(mechanism_ids(values['diagnose_mechanisms']), values['channel'])
         except ConfigError as exc:
             return f'diagnose_mechanisms: {exc}'
     node = values['compensator_node']
