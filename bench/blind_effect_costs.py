@@ -132,14 +132,19 @@ def clean_figures(rows: list[dict], right: Callable[[dict], bool]) -> str:
     kept = [r for r in big if clean[str(r['index'])] <= CLEAN_OK]
     with_effects = [r for r in rows if r['effects']]
     missed = [r['index'] for r in with_effects if clean[str(r['index'])] > 3.0]
-    beyond = sum(_beyond_training_levels(i) > 0.05 for i in missed)
+    shares = {i: _beyond_training_levels(i) for i in missed}
+    beyond = {i: m for i, (m, _) in shares.items() if m > 0.05}
+    inside = sum(shares[i][1] <= 0.05 for i in beyond)
     unfit = [i for i in missed if train[str(i)] > CLEAN_OK]
     return '\n'.join([
         'Where the chain alone predicts the clean draw (`python bench/blind_effect_costs.py '
         '--clean`: every recording with effects drawn again without any, the baseline on '
         f'each; {len(missed)} of the {len(with_effects)} clean draws are missed by more '
-        f'than 3 x the floor, {beyond} of them with more than 5 % of the held-out '
-        "measurement beyond the training part's levels: there the split asks the chain "
+        f'than 3 x the floor, {len(beyond)} of them with more than 5 % of the held-out '
+        "measurement beyond the training part's levels ("
+        + ', '.join(f'#{i} {100 * m:.0f} %' for i, m in beyond.items())
+        + f'; in {inside} of them 95 % or more of the held-out commands lie inside the '
+        'training range): there the split asks the chain '
         f'to extrapolate; {len(missed) - len(unfit)} of the {len(missed)} fit their training '
         f'part within {CLEAN_OK} x its floor, the baseline stops above it on '
         + (', '.join(f'#{i} ({train[str(i)]:.2f} x)' for i in unfit) or 'none') + '):', '',
@@ -169,13 +174,17 @@ def _both_refinements(rows: list[dict], clean: dict) -> list[str]:
             f'{len(right)}/{len(recs)} |']
 
 
-def _beyond_training_levels(index: int, train_fraction: float = 0.7) -> float:
-    """Share of the clean draw's held-out measurement beyond its training levels (1 % margin)."""
-    y = draw(index, only=frozenset())['measurement']
-    n = int(round(train_fraction * y.size))
-    lo, hi = float(y[:n].min()), float(y[:n].max())
-    margin = 0.01 * (hi - lo)
-    return float(((y[n:] > hi + margin) | (y[n:] < lo - margin)).mean())
+def _beyond_training_levels(index: int, train_fraction: float = 0.7) -> tuple[float, float]:
+    """Shares of the clean draw's held-out measurement (1 % margin) and command beyond training."""
+    case = draw(index, only=frozenset())
+    n = int(round(train_fraction * case['measurement'].size))
+
+    def beyond(x, margin: float) -> float:
+        lo, hi = float(x[:n].min()), float(x[:n].max())
+        pad = margin * (hi - lo)
+        return float(((x[n:] > hi + pad) | (x[n:] < lo - pad)).mean())
+
+    return beyond(case['measurement'], 0.01), beyond(case['command'], 0.0)
 
 
 def _gaass_out(gaass: list[int]) -> Path:

@@ -133,7 +133,7 @@ def test_the_clean_draw_figures_set_apart_what_the_split_costs_the_chain(tmp_pat
     (tmp_path / 'alone.json').write_text(json.dumps({'1': {'a': 9.0, 'b': 1.1}}))
     monkeypatch.setattr(costs, 'CLEAN_OUT', tmp_path / 'clean.json')
     monkeypatch.setattr(costs, 'OUT', tmp_path / 'alone.json')
-    monkeypatch.setattr(costs, '_beyond_training_levels', lambda index: 0.0)
+    monkeypatch.setattr(costs, '_beyond_training_levels', lambda index: (0.0, 0.0))
     text = costs.clean_figures(rows, blind_family._right)
     assert '1 of the 4 clean draws are missed by more than 3 x' in text
     assert '0 of the 1 fit their training part within 1.5 x' in text and '#2 (2.50 x)' in text
