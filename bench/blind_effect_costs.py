@@ -256,8 +256,8 @@ def main() -> int:
     cases = [draw(i) for i in range(args.n)]
     if args.clean:
         tasks = [(c['index'], '') for c in cases if c['effects']]
-        checks = [(c['index'], '') for c in cases
-                  if not c['effects'] and c['index'] in blind][:args.check]
+        checks = [(c['index'], '') for c in cases      # other GAASS: nothing to check
+                  if not c['effects'] and c['index'] in blind and not args.gaass][:args.check]
     else:
         tasks = [(c['index'], e) for c in cases if len(c['effects']) == 2
                  for e in c['effects']]
@@ -267,8 +267,6 @@ def main() -> int:
     train_fit: dict[str, float] = {}         # --clean: the training fit over its floor
     disagree, t0, times = 0, time.time(), []
     with ProcessPoolExecutor(max_workers=args.workers) as pool:
-        if args.gaass:           # other settings: nothing to check against the blind run
-            checks = []
         futures = [pool.submit(alone_cost, i, e, tuple(args.gaass) if args.gaass else None)
                    for i, e in tasks + checks]
         for k, fut in enumerate(as_completed(futures), 1):
