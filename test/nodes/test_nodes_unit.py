@@ -545,3 +545,16 @@ def test_replay_clock_keeps_bag_time_at_any_rate(ctx, tmp_path, sim_time):
         assert stamps[-1] - stamps[0] == pytest.approx(5.9, abs=0.25)
     else:            # arrival time: four times faster
         assert spacing == pytest.approx(0.025, abs=0.01)
+
+
+def test_a_push_to_an_invalid_node_name_is_logged_and_dropped(ctx, monkeypatch):
+    """The pusher never raises into the executor: a bad target is an ERROR log, not a crash."""
+    from hyst_id.nodes.support.pusher import ParameterPusher
+    node = _make(ctx, Node, 'pusher_host')
+    said: list[str] = []
+    monkeypatch.setattr(node.get_logger(), 'error', lambda m, **kw: said.append(m))
+    pusher = ParameterPusher(node)
+    pusher.push('bad name!', [Parameter('m_l', value=1.0)], timeout_s=1.0)
+    pusher.poll()
+    assert said and 'cannot push the parameters to bad name!' in said[0]
+    assert pusher._pending is None
