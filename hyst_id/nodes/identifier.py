@@ -214,8 +214,8 @@ class Identifier(HystNode):
         self._eor_tried = False
 
     def _non_finite(self) -> None:
-        self.get_logger().warning(self.buffer.non_finite_note + ' (not collected)',
-                                  throttle_duration_sec=5.0)
+        # counted and logged; the next /diagnostics status is an ERROR, as on every node
+        self.note_non_finite('sample (not collected)')
 
     # ------------------------------------------------------------ requests
     def _on_trigger(self, fn: Callable[[str], tuple[bool, str]], response: Any) -> Any:
@@ -490,6 +490,7 @@ class Identifier(HystNode):
         problems = input_problems(   # a wrong type, or one input arriving without the other
             self, self._expected, self._rx, self._started, self.p('input_timeout_s'),
             {'command': self.p('topics.command_topic'), 'measurement': self._meas_topic})
+        problems += [w for w in [self.non_finite_problem()] if w]
         if problems:
             level, msg = 2, '; '.join(problems) + f' ({msg})'
             self.get_logger().error('; '.join(problems), throttle_duration_sec=10.0)

@@ -36,6 +36,7 @@ rclpy = pytest.importorskip('rclpy')
 
 from rclpy.node import Node  # noqa: E402
 from rclpy.parameter import Parameter  # noqa: E402
+from sensor_msgs.msg import JointState  # noqa: E402
 from std_msgs.msg import String  # noqa: E402
 
 from hyst_id.compensation.params_file import write_compensator_params  # noqa: E402
@@ -125,20 +126,28 @@ def test_a_gap_too_long_for_one_run_is_refused_and_the_last_set_stays(ctx, tmp_p
 
 
 def test_a_refused_run_keeps_its_samples_and_non_finite_ones_are_not_collected(ctx, tmp_path):
-    """A NaN is dropped on arrival (counted, a WARN); a run refused keeps what was collected."""
+    """A NaN is dropped on arrival (counted, an ERROR on the next status, then a WARN).
+
+    A run refused keeps what was collected.
+    """
     ident = _make(ctx, Identifier, parameter_overrides=FAST + [Parameter('min_samples',
                                                                          value=50)])
+    sent: list[tuple[int, str]] = []
+    ident.publish_diagnostics = lambda level, msg, values=None, **kw: sent.append((level, msg))
     stamps, v, y = _samples()
-    y = y.copy()
-    y[150] = np.nan
-    _feed(ident, stamps, v, y)
+    _feed(ident, stamps, v, y, order=np.r_[0:150, 151:400])
+    ident._on_measurement(JointState(position=[np.nan]), {})     # as the subscription does
     assert ident.buffer.n_measurements == 399 and ident.buffer.non_finite['measurement'] == 1
     assert '1 measurement sample(s) with a NaN' in ident.collected_recording().notes[-1]
+    ident._status()
+    assert sent[-1][0] == 2 and '1 non-finite input value(s)' in sent[-1][1], sent[-1]
+    ident._status()                     # none since: the run's gap stays visible as a WARN
+    assert sent[-1][0] == 1 and 'with a NaN' in sent[-1][1], sent[-1]
     ident.buffer.clear()
     _feed(ident, stamps, np.full(400, 9.0), y)              # no excitation: refused
     ok, message = ident.request_identification('test')
     assert not ok and 'samples kept' in ident.last_error, ident.last_error
-    assert ident.buffer.n_measurements == 399               # not cleared: nothing lost
+    assert ident.buffer.n_measurements == 400               # not cleared: nothing lost
 
 
 def test_a_bad_compensator_node_domains_file_or_mechanism_is_refused_when_set(ctx, tmp_path):
