@@ -308,10 +308,16 @@ class BagContents:
         """Yield ``(topic, msgtype, t_ns, message)`` in log-time order."""
         wanted = list(self.topics) if topics is None else list(topics)
         self.check_topics(wanted)
+        n_read = 0
         try:
-            yield from self._source(set(wanted))
+            for item in self._source(set(wanted)):
+                yield item
+                n_read += 1
         except _READ_ERRORS as exc:
-            raise RecordingError(f'cannot read bag {self.path}: {_one_line(exc)}') from None
+            where = (f' after {n_read} good message(s): the file is damaged there'
+                     if n_read else '')
+            raise RecordingError(
+                f'cannot read bag {self.path}{where}: {_one_line(exc)}') from None
 
 
 def _one_line(exc: BaseException) -> str:

@@ -167,7 +167,9 @@ class Replay(HystNode):
             self.get_logger().info(f'replay finished: {self.published} messages in '
                                    f'{time.monotonic() - t0_wall:.2f} s')
         except HystIdError as exc:
-            self.get_logger().error(str(exc))
+            played = (f' ({self.published} message(s) were played before it; the rest of the '
+                      'bag was not)' if self.published else '')
+            self.get_logger().error(f'{exc}{played}')
             self.exit_code = 2
         except Exception as exc:  # noqa: BLE001 - report in one line, never a traceback
             self.get_logger().error(f'replay failed: {type(exc).__name__}: {exc}')

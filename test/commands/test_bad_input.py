@@ -298,3 +298,21 @@ def test_damaged_bags_give_a_clear_error_never_an_internal_one(tmp_path):
         except HystIdError:
             outcomes['refused'] += 1
     assert outcomes['refused'] > 0, outcomes
+
+
+def test_damage_in_the_middle_of_a_bag_says_how_much_was_read_before_it(tmp_path):
+    """The error names how many messages were read before the damaged record."""
+    from hyst_id.errors import RecordingError
+    from hyst_id.io.bag import iter_bag_messages
+    bag = make_bag(tmp_path / 'good')
+    data = bytearray(next(bag.glob('*.mcap')).read_bytes())
+    start = len(data) // 4                           # inside a chunk a quarter into the file
+    data[start:start + 50] = bytes(b ^ 0xFF for b in data[start:start + 50])
+    path = tmp_path / 'mid.mcap'
+    path.write_bytes(bytes(data))
+    n_read = 0
+    with pytest.raises(RecordingError) as err:
+        for _ in iter_bag_messages(path):
+            n_read += 1
+    assert n_read > 0
+    assert f'after {n_read} good message(s): the file is damaged there' in str(err.value)
