@@ -33,8 +33,16 @@ commands at the upper command limit (a level the plant cannot give), and, with a
 map (``static_nonlinearity``), the share of the run's model targets past the
 travel the map was fitted on (``|z| > 1``, where it continues straight).
 
+With ``--supply`` each probe instead sets the drift blocks against the rig
+itself: how much of the supply's excess over ambient (``p_s - p_amb``, the
+rig's noise-free internal signal) is lost over the run, and what each drift
+block (``offset_drift``, ``gain_drift``, ``supply_decay``), fitted alone,
+makes of it: its training and held-out %e_r and its fitted change over the
+run. A block whose training fit is as good as another's but whose held-out
+part is far worse has fitted the drift's shape, not its size.
+
 Usage: ``python bench/rig_diagnosis_roundoff.py [--channel pressure] [--probes 0 1 2 3]
-[--augmented]`` (about a minute per probe).
+[--augmented | --supply]`` (about a minute per probe; two with ``--supply``).
 """
 
 from __future__ import annotations
@@ -98,15 +106,44 @@ if aug.has_output_map:
           f'z {z.min():.3g} .. {z.max():.3g}')
 """
 
+SUPPLY = """
+import numpy as np
+from hyst_id.diagnosis import diagnose, DiagnoseSettings
+from hyst_id.rig import as_rig_params, simulate_rig
+from hyst_id.signals.excitation import eq24
+rig = as_rig_params('params/paper_rig.yaml').with_values({'supply.regulation': False})
+t = np.arange(0.0, 100.0, 0.05)
+run = simulate_rig(rig, t, eq24(t), seed=0)
+print('drift blocks fitted alone')
+excess = run.truth['supply_pressure_pa'] - rig.gas.ambient_pressure_pa
+print(f'    the rig: supply excess over ambient {excess[0]:.4g} -> {excess[-1]:.4g} Pa, '
+      f'{100 * (1 - excess[-1] / excess[0]):.1f} %% lost over the run')
+for m in ('offset_drift', 'gain_drift', 'supply_decay'):
+    d = diagnose(run.recording(%r), settings=DiagnoseSettings(max_mechanisms=1, mechanisms=(m,)))
+    c = d.to_dict()['tested'][0]['candidates'][0]
+    f = ({k: v['value'] for k, v in d.to_dict()['findings'][0]['params'].items()}
+         if d.findings else {})
+    size = {'offset_drift': f"offset {f.get('drift_over_record', np.nan):.4g} Pa",
+            'gain_drift': f"gain +{f.get('gain_growth_percent', np.nan):.3g} %%",
+            'supply_decay': f"gain -{f.get('gain_loss_percent', np.nan):.3g} %%, "
+                            f"time constant {f.get('time_constant_s', np.nan):.3g} s"}[m]
+    print(f'    {m} alone: %%e_r train {c["er_train_percent"]:.3g}, held-out '
+          f'{c["er_holdout_percent"]:.3g} ({c["status"]}); over the run: {size}')
+"""
+
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument('--channel', default='pressure', choices=('position', 'pressure', 'flow'))
     ap.add_argument('--probes', type=int, nargs='+', default=[0, 1, 2, 3])
-    ap.add_argument('--augmented', action='store_true',
-                    help='column (b) of hyst-id experiment per probe, not the diagnosis alone')
+    how = ap.add_mutually_exclusive_group()
+    how.add_argument('--augmented', action='store_true',
+                     help='column (b) of hyst-id experiment per probe, not the diagnosis alone')
+    how.add_argument('--supply', action='store_true',
+                     help="the drift blocks fitted alone against the rig's supply loss")
     args = ap.parse_args()
-    code = AUGMENTED % ((args.channel,) * 3) if args.augmented else ONE % args.channel
+    code = (AUGMENTED % ((args.channel,) * 3) if args.augmented
+            else SUPPLY % args.channel if args.supply else ONE % args.channel)
     for probe in args.probes:
         env = dict(os.environ, HYST_ID_ROUNDOFF_PROBE=str(probe))
         if probe == 0:
