@@ -44,9 +44,10 @@ from hyst_id.identification.incumbent import (
     rank_conventions,
     search_subset,
 )
-from hyst_id.identification.quality import assess
+from hyst_id.identification.quality import assess, FIT_FACTOR
 from hyst_id.identification.refine import refine
 from hyst_id.identification.result import Identification, IdentifySettings, SeedRun
+from hyst_id.identification.start_state import left_out_note, refit_start
 from hyst_id.identification.workers import map_in_processes, n_processes, WorkersStopped
 from hyst_id.io.recording import Recording, roundoff_probe, validate_recording
 from hyst_id.signals.noise import noise_floor_percent
@@ -233,7 +234,28 @@ def identify(recording: Recording, *, spec: ChainSpec | None = None,
     -------
     Identification
     """
-    rec = roundoff_probe(validate_recording(recording))
+    rec = validate_recording(recording)
+    ident = _identify(rec, spec, settings, progress, on_generation, should_stop)
+    k = refit_start(rec.command, ident.er_percent, ident.noise_floor_percent)
+    if k is None:
+        return ident
+    # a start inside the play or loop (see start_state): a short probe from the first reversal
+    rest, before = rec.window(k, rec.n_samples), ident.er_percent / ident.noise_floor_percent
+    full = settings or IdentifySettings()
+    probe = _identify(rest, spec, replace(full, seeds=full.seeds[:2], global_runs=0, hops=0),
+                      None, None, should_stop)
+    if not probe.er_percent / probe.noise_floor_percent * FIT_FACTOR < before:
+        return ident
+    again = _identify(rest, spec, full, progress, on_generation, should_stop)
+    after = again.er_percent / again.noise_floor_percent
+    again.warnings.insert(0, left_out_note(rec.t_s, k, before, after))
+    return again
+
+
+def _identify(rec: Recording, spec: ChainSpec | None, settings: IdentifySettings | None,
+              progress, on_generation, should_stop) -> Identification:
+    """:func:`identify` of a validated recording, as it is."""
+    rec = roundoff_probe(rec)
     settings = settings or IdentifySettings()
     spec = spec or domains_from_data(rec)
     if spec.channel != rec.channel:
