@@ -55,6 +55,7 @@ if TYPE_CHECKING:
     from hyst_id.io.recording import Recording
 
 __all__ = [
+    'NOISE_FREE_RATIO',
     'assess',
     'domain_edge_warnings',
     'fit_warnings',
@@ -68,6 +69,9 @@ __all__ = [
 
 #: %e_r over the noise floor above which the fit is called incomplete.
 FIT_FACTOR = 1.5
+#: A fit this many times its noise floor or more is read as a fit to a noise-free (or
+#: smoothed) record, whose floor is about 0: a ratio to it says nothing.
+NOISE_FREE_RATIO = 1000.0
 #: Seeds within this factor of the best %e_r count as converged.
 CONVERGED_FACTOR = 1.1
 #: Relative spread or standard error above which a parameter is poorly determined.
@@ -160,7 +164,11 @@ def fit_warnings(ident: Identification) -> list[str]:
     """Warn about a fit above the noise floor and about seeds in other optima."""
     out = []
     floor = ident.noise_floor_percent
-    if floor > 0 and ident.er_percent > FIT_FACTOR * floor:
+    if ident.er_percent > 1e-9 and not ident.er_percent < NOISE_FREE_RATIO * floor:
+        out.append(f'the noise floor is about 0 (a noise-free or smoothed record) and the fit '
+                   f'misses by %e_r {ident.er_percent:.4g}: the model misses part of the '
+                   'response; look at the residual plot')
+    elif floor > 0 and ident.er_percent > FIT_FACTOR * floor:
         out.append(f'the best %e_r is {ident.er_percent / floor:.1f} x the noise floor: the '
                    'model misses part of the response (unmodelled dynamics, drift, a loop '
                    'shape it cannot make); look at the residual plot')

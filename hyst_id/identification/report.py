@@ -26,6 +26,7 @@ import numpy as np
 
 from hyst_id.identification import Identification
 from hyst_id.identification.chains import er_percent, param_units
+from hyst_id.identification.quality import NOISE_FREE_RATIO
 from hyst_id.io.jsonable import jsonable
 from hyst_id.io.recording import Recording
 
@@ -57,26 +58,48 @@ def format_table(ident: Identification, truth: dict | None = None) -> str:
     lines = [f'channel: {ident.channel}   H family: {ident.family}   {runs}   '
              f'domains: {ident.domain_source}   {convention}', head, '-' * len(head)]
     for i, name in enumerate(ident.names):
-        row = (f'{name:8s} {units[name]:8s} {ident.params_mean[name]:11.4f} '
-               f'{ident.params[name]:11.4f} {spread[i]:9.4f}')
+        mean, best = ident.params_mean[name], ident.params[name]
+        std = spread[i] if spread[i] > 1e-9 * max(abs(mean), abs(best)) else 0.0  # round-off
+        row = f'{name:8s} {units[name]:8s} {_num(mean, 11)} {_num(best, 11)} {_num(std, 9)}'
         if truth:
-            row += f' {truth.get(name, float("nan")):11.4f}'
+            row += f' {_num(truth.get(name, float("nan")), 11)}'
         lines.append(row)
     er = np.array([r.er_percent for r in ident.runs])
     floor = ident.noise_floor_percent
     lines += [
         '-' * len(head),
-        f'%e_r best run        {ident.er_percent:8.3f}   '
-        f'({ident.er_percent / floor:.2f} x noise floor)' if floor > 0 else
-        f'%e_r best run        {ident.er_percent:8.3f}',
-        f'%e_r mean params     {ident.er_mean_params_percent:8.3f}'
+        f'%e_r best run        {_num(ident.er_percent, 8, 3)}   ' + _floor_ratio(
+            ident.er_percent, floor),
+        f'%e_r mean params     {_num(ident.er_mean_params_percent, 8, 3)}'
         if np.isfinite(ident.er_mean_params_percent) else
         '%e_r mean params          n/a  (the mean of the runs is not a valid loop)',
-        f'%e_r over runs       median {np.median(er):.3f}  worst {er.max():.3f}',
-        f'noise floor %e_r     {floor:8.3f}',
+        f'%e_r over runs       median {_num(np.median(er), 0, 3)}  worst '
+        f'{_num(er.max(), 0, 3)}',
+        f'noise floor %e_r     {_num(floor, 8, 3)}',
     ]
     lines += [f'warning: {w}' for w in ident.warnings]
     return '\n'.join(lines)
+
+
+def _num(value: float, width: int, decimals: int = 4) -> str:
+    """``value`` in ``decimals`` fixed decimals, or in significant figures when that hides it.
+
+    Fixed decimals print a value in micrometres or pascals as ``0.0000`` or
+    as a long string of digits; those get ``decimals + 1`` significant figures.
+    """
+    v = float(value)
+    fixed = f'{v:{width}.{decimals}f}'
+    if not np.isfinite(v) or v == 0.0 or 10.0 ** -(decimals - 1) <= abs(v) < 1e5:
+        return fixed
+    return f'{v:{width}.{decimals + 1}g}'
+
+
+def _floor_ratio(er_percent: float, floor_percent: float) -> str:
+    """The fit's ratio to its noise floor in words, or why there is none."""
+    if not floor_percent > 0.0 or er_percent > NOISE_FREE_RATIO * floor_percent:
+        return ('(noise floor about 0: the record is noise-free or smoothed, so a ratio to it '
+                'says nothing)')
+    return f'({er_percent / floor_percent:.2f} x noise floor)'
 
 
 def write_json(ident: Identification, path: str | Path, extra: dict | None = None) -> None:

@@ -74,6 +74,7 @@ def test_only_a_poor_fit_of_a_record_that_reverses_after_a_stretch_is_tried_agai
     assert refit_start(v, 1.0, 0.5) == 50
     assert refit_start(v, 0.7, 0.5) is None             # within 1.5 x the floor
     assert refit_start(v, 1.0, 0.0) is None             # no floor to judge by
+    assert refit_start(v, 1.0, 1e-4) is None            # a noise-free record
     assert refit_start(np.sin(np.linspace(0.0, 2 * np.pi, 600)), 1.0, 0.5) is None
     late = np.concatenate([np.zeros(400), v[:400]])     # the reversal past half the record
     assert refit_start(late, 1.0, 0.5) is None

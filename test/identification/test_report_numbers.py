@@ -1,0 +1,67 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""Identify's table in any units (an independent reviewer's µm and Pa recordings).
+
+Before: fixed four decimals printed every slope of a recording in metres as
+``0.0000``, and a noise-free record's fit as 53303 x its noise floor.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from hyst_id.identification import identify, IdentifySettings
+from hyst_id.identification.report import _floor_ratio, _num, format_table
+from hyst_id.io.recording import Recording
+
+
+def test_numbers_keep_their_digits_in_any_unit():
+    assert _num(4.2624, 11) == '     4.2624'                   # ordinary values: as before
+    assert _num(-95.2581, 11) == '   -95.2581'
+    assert _num(0.0, 9) == '   0.0000'
+    assert float(_num(1.25e-05, 11)) == 1.25e-05               # not 0.0000
+    assert _num(1.25e-05, 11).strip() == '1.25e-05'
+    assert float(_num(-9040119.969, 11)) == -9.0401e+06        # fits its column
+    assert len(_num(-9040119.969, 11)) == 11
+    assert _num(float('nan'), 11).strip() == 'nan'
+
+
+def test_a_fit_to_a_floor_of_about_zero_has_no_ratio():
+    assert _floor_ratio(0.5, 0.49) == '(1.02 x noise floor)'
+    assert 'noise-free' in _floor_ratio(2.961, 2.961 / 53303.0)
+    assert 'noise-free' in _floor_ratio(0.5, 0.0)
+
+
+def test_a_noise_free_record_gets_no_ratio_in_its_warning():
+    t = np.arange(0.0, 20.0, 0.01)
+    v = 5 * np.sin(2 * np.pi * 0.2 * t)
+    y = np.round(2.0 * np.clip(v, -3, 3) + 0.2 * np.sin(2 * np.pi * 1.3 * t), 9)  # no noise
+    ident = identify(Recording(t, v, y, 'position'),
+                     settings=IdentifySettings(seeds=(0,), workers=1, global_runs=0, hops=0))
+    assert ident.er_percent > 1000 * ident.noise_floor_percent        # the case itself
+    assert any('noise floor is about 0' in w for w in ident.warnings), ident.warnings
+    assert not any('x the noise floor' in w for w in ident.warnings), ident.warnings
+    assert 'noise-free' in format_table(ident)
+
+
+def test_a_recording_in_micrometres_prints_its_slopes():
+    t = np.arange(0.0, 20.0, 0.01)
+    v = 5 * np.sin(2 * np.pi * 0.2 * t)
+    y = 1e-6 * (2.0 * np.clip(v, -3, 3) + np.random.default_rng(0).normal(0, 0.01, t.size))
+    ident = identify(Recording(t, v, y, 'position'),
+                     settings=IdentifySettings(seeds=(0,), workers=1, global_runs=0, hops=0))
+    rows = {line.split()[0]: line.split() for line in format_table(ident).splitlines()[3:14]}
+    assert float(rows['m_l'][3]) != 0.0 and float(rows['m_r'][3]) != 0.0, rows
+    assert abs(float(rows['m_r'][3]) - ident.params['m_r']) <= 1e-4 * abs(ident.params['m_r'])
