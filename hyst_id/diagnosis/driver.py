@@ -78,7 +78,7 @@ from hyst_id.diagnosis.select import (
 from hyst_id.diagnosis.trial import try_all
 from hyst_id.errors import ConfigError, RecordingError
 from hyst_id.identification.chains import chain_spec, ChainSpec
-from hyst_id.io.recording import Recording, roundoff_probe, validate_recording
+from hyst_id.io.recording import Recording, roundoff_probe, validate_part, validate_recording
 from hyst_id.signals.noise import floor_percent
 from hyst_id.signals.reversals import period_s
 from hyst_id.signals.split import inside_rows, level_excursion, split_index
@@ -212,7 +212,8 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
         scale = (1.0, 0.0)
     v = (v_orig - scale[1]) / scale[0]
     rec_train = Recording(t[:n_train], v[:n_train], y[:n_train], rec.channel, source=rec.source)
-    validate_recording(rec_train)
+    validate_part(rec_train, f'its training part (the first {settings.train_fraction:.0%} of '
+                  'its duration; train_fraction sets it)')
     ctx = Context(channel=rec.channel, t_s=t, n_train=n_train, command_scale=scale,
                   command_unit=rec.command_unit, measurement_unit=rec.measurement_unit,
                   extra={'period_s': period_s(t[:n_train], v[:n_train])})

@@ -36,6 +36,7 @@ __all__ = [
     'Recording',
     'ROUNDOFF_PROBE_ENV',
     'roundoff_probe',
+    'validate_part',
     'validate_recording',
 ]
 
@@ -218,6 +219,19 @@ def validate_recording(rec: Recording, *, min_samples: int = MIN_SAMPLES,
     if np.ptp(arrays['measurement']) <= 0.0:
         raise RecordingError('measurement is constant: the sensor shows no response')
     return replace(rec, **arrays)
+
+
+def validate_part(part: Recording, what: str) -> Recording:
+    """:func:`validate_recording` of a part of a record; an error names the part and file.
+
+    ``what`` says which part (e.g. the training part of a split and what sets it), so
+    that a record that passes as a whole is not refused for a reason it does not have.
+    """
+    try:
+        return validate_recording(part)
+    except RecordingError as exc:
+        where = f'{part.source}: ' if part.source else ''
+        raise type(exc)(f'{where}{what}: {exc}') from None
 
 
 #: Environment variable of the round-off probe (``<seed>`` or ``<seed>:<relative size>``).

@@ -316,3 +316,15 @@ def test_damage_in_the_middle_of_a_bag_says_how_much_was_read_before_it(tmp_path
             n_read += 1
     assert n_read > 0
     assert f'after {n_read} good message(s): the file is damaged there' in str(err.value)
+
+
+def test_diagnose_names_the_training_part_when_only_it_lacks_reversals(tmp_path, capsys):
+    """A record that reverses twice, once in its first 70 %: the error says which part."""
+    t = np.arange(200) * 0.01
+    v = np.sin(2 * np.pi * 0.5 * t)                       # reversals at 0.5 s and 1.5 s
+    y = np.clip(v, -0.5, 0.5) + np.random.default_rng(0).normal(0, 0.01, t.size)
+    csv = write_csv(tmp_path / 'two.csv', t, v, y)
+    assert main(['diagnose', str(csv)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert str(csv) in err and 'its training part (the first 70% of its duration' in err, err
+    assert 'command reverses 1 time(s)' in err
