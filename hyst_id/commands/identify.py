@@ -73,6 +73,9 @@ def run(args: argparse.Namespace) -> int:
         spec = make_spec(args, rec, family=args.model)
         print(f'H family {spec.family.id}; search domains ({spec.domain_source}): '
               + format_domains(spec), file=sys.stderr)
+        print('  (the search scales: output-side domains before the calibration to '
+              'measurement units and the canonical gauge, so the parameters reported may lie '
+              'outside them)', file=sys.stderr)
         bar = _progress_bar(args, settings)
         try:
             ident = identify(rec, spec=spec, settings=settings, progress=bar)

@@ -56,9 +56,11 @@ if TYPE_CHECKING:
 
 __all__ = [
     'NOISE_FREE_RATIO',
+    'UNDER_FLOOR',
     'assess',
     'domain_edge_warnings',
     'fit_warnings',
+    'floor_estimate_warnings',
     'identification_warnings',
     'orientation_warnings',
     'parameter_scales',
@@ -72,6 +74,9 @@ FIT_FACTOR = 1.5
 #: A fit this many times its noise floor or more is read as a fit to a noise-free (or
 #: smoothed) record, whose floor is about 0: a ratio to it says nothing.
 NOISE_FREE_RATIO = 1000.0
+#: A fit below this share of its noise floor (after what fitting the parameters takes
+#: off the noise) says the floor was estimated too high.
+UNDER_FLOOR = 0.8
 #: Seeds within this factor of the best %e_r count as converged.
 CONVERGED_FACTOR = 1.1
 #: Relative spread or standard error above which a parameter is poorly determined.
@@ -125,7 +130,7 @@ def assess(ident: Identification, rec: Recording,
     if spec is None:
         spec = replace(ident.spec(), calibration=None)
     out = orientation_warnings(rec, _sign(ident))
-    out += fit_warnings(ident)
+    out += fit_warnings(ident) + floor_estimate_warnings(ident, rec.n_samples)
     out += domain_edge_warnings(ident, rec, spec)
     unexcited, names = unexcited_warnings(ident, rec)
     out += unexcited
@@ -179,6 +184,28 @@ def fit_warnings(ident: Identification) -> list[str]:
                    f'{100 * (CONVERGED_FACTOR - 1):.0f} % above the best %e_r (other local '
                    'optima): the best run is reported; the mean over seeds mixes optima')
     return out
+
+
+def floor_estimate_warnings(ident: Identification, n_samples: int) -> list[str]:
+    """Warn when the fit is further below the noise floor than noise allows.
+
+    A least-squares fit of ``p`` parameters (H, B, the sensor and the
+    calibration) to ``n`` samples of white noise leaves about ``sqrt(1 - p/n)``
+    of it. A fit below :data:`UNDER_FLOOR` of that says the floor, estimated
+    from differences of neighbouring samples, is too high: a signal that moves
+    much between samples (few samples per loop, coarse or uneven sampling)
+    adds to those differences.
+    """
+    floor = ident.noise_floor_percent
+    p = len(ident.names) + 2
+    left = np.sqrt(max(0.0, 1.0 - p / max(n_samples, 1)))
+    if not (floor > 0.0 and ident.er_percent < UNDER_FLOOR * left * floor):
+        return []
+    return [f'the fit is {ident.er_percent / floor:.2f} x the noise floor, below what noise '
+            'allows: the floor is estimated too high here (it is estimated from differences of '
+            'neighbouring samples, which a signal that moves much between samples inflates: '
+            'few samples per loop, coarse or uneven sampling), so a ratio to it flatters the '
+            'fit; judge the fit by its residual plot']
 
 
 def _at_edge(x: np.ndarray, bounds: np.ndarray) -> np.ndarray:
