@@ -61,7 +61,8 @@ def _identify_base(settings) -> dict:
     """The identify settings of a diagnosis baseline, from its ``DiagnoseSettings``."""
     return {'pop_size': settings.pop_size, 'maxiter': settings.generations,
             'seeds': tuple(settings.seeds), 'workers': settings.workers, 'refine': True,
-            'refine_top': 2, 'restarts': 1, 'refine_max_nfev': 1500, 'hops': settings.hops}
+            'refine_top': 2, 'restarts': 1, 'refine_max_nfev': 1500, 'hops': settings.hops,
+            'start_state': False}
 
 
 def baseline_starts(rec_train: Recording, spec: ChainSpec, settings, *, thorough: bool = True,

@@ -236,12 +236,12 @@ def identify(recording: Recording, *, spec: ChainSpec | None = None,
     """
     rec = validate_recording(recording)
     ident = _identify(rec, spec, settings, progress, on_generation, should_stop)
+    full = settings or IdentifySettings()
     k = refit_start(rec.command, ident.er_percent, ident.noise_floor_percent)
-    if k is None:
+    if k is None or not full.start_state:
         return ident
     # a start inside the play or loop (see start_state): a short probe from the first reversal
     rest, before = rec.window(k, rec.n_samples), ident.er_percent / ident.noise_floor_percent
-    full = settings or IdentifySettings()
     probe = _identify(rest, spec, replace(full, seeds=full.seeds[:2], global_runs=0, hops=0),
                       None, None, should_stop)
     if not probe.er_percent / probe.noise_floor_percent * FIT_FACTOR < before:

@@ -122,6 +122,13 @@ class IdentifySettings:
         verdicts of recordings with effects (two from right to wrong) and
         made a diagnosis 1.7 x slower (median, 75 recordings;
         docs/diagnosis.md). Nothing to do with ``refine`` off.
+    start_state : bool
+        When the fit stays above 1.5 x the noise floor, try the record from
+        the command's first reversal on and keep that fit when it is clearly
+        closer to its floor (:mod:`hyst_id.identification.start_state`: an
+        actuator that starts inside its play). Off in the paper's experiment
+        (the paper fits the whole run) and in a diagnosis's baseline (judged
+        on the whole record; its blind-family figures were measured without).
     """
 
     pop_size: int = 10
@@ -146,6 +153,7 @@ class IdentifySettings:
     hops: int = 100
     search_samples: int = 20000
     more_starts: bool = False
+    start_state: bool = True
 
 
 @dataclass

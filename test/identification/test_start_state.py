@@ -27,9 +27,13 @@ and is never refitted. The margin 1.2 x is the package's usual one over the floo
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
+from hyst_id.diagnosis import DiagnoseSettings
+from hyst_id.diagnosis.baseline import _identify_base
 from hyst_id.identification import identify, IdentifySettings
 from hyst_id.identification.start_state import refit_start
 from hyst_id.io.recording import Recording
@@ -61,6 +65,15 @@ def test_a_start_inside_the_play_is_left_out_and_the_rest_fits_to_the_floor(seed
     assert ident.er_percent <= 1.2 * ident.noise_floor_percent, ident.warnings
     assert 'are left out of the fit' in ident.warnings[0], ident.warnings
     assert 'inside its play or loop' in ident.warnings[0]
+
+
+def test_the_retry_is_off_where_the_whole_record_is_judged():
+    """The paper's experiment and a diagnosis's baseline fit the whole record, as before."""
+    ident = identify(_recording(0, 10.0, inside=True),
+                     settings=replace(SETTINGS, start_state=False))
+    assert ident.er_percent > 5 * ident.noise_floor_percent
+    assert not any('left out of the fit' in w for w in ident.warnings), ident.warnings
+    assert not _identify_base(DiagnoseSettings())['start_state']
 
 
 def test_a_start_on_the_edge_of_the_play_is_fitted_whole():
