@@ -435,6 +435,10 @@ class AugmentedCompensator:
         return out
 
 
+#: A schedule referred to the record's start (the diagnosis's own set).
+_AT_START = {'gain_reference': 1.0, 'offset_reference_s': 0.0}
+
+
 def augmentation_from_findings(findings: Iterable[Any], record_duration_s: float,
                                model_from: str = 'identification'
                                ) -> tuple[Augmentation, list[tuple[str, str]]]:
@@ -450,7 +454,10 @@ def augmentation_from_findings(findings: Iterable[Any], record_duration_s: float
     model_from : {'identification', 'diagnosis'}
         Whose H and B the compensator runs: an output map (``poly_*``) is
         written in the diagnosis's own travel units, so it is applied only
-        with the diagnosis's set.
+        with the diagnosis's set. The diagnosis's set holds for the plant at
+        the record's start, so its schedules are referred there
+        (``gain_reference`` 1, ``offset_reference_s`` 0), in the values and
+        in the words.
 
     Returns
     -------
@@ -463,6 +470,9 @@ def augmentation_from_findings(findings: Iterable[Any], record_duration_s: float
     for f in findings:
         d = f if isinstance(f, Mapping) else f.to_dict()
         corr = dict((d.get('compensation') or {}).get('correction') or {})
+        if model_from == 'diagnosis':
+            corr.update({AUGMENT_PREFIX + k: v for k, v in _AT_START.items()
+                         if AUGMENT_PREFIX + k in corr})
         if not corr:
             applied.append((d['mechanism'], 'no in-line correction: '
                             + str((d.get('compensation') or {}).get('how', ''))))

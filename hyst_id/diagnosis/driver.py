@@ -304,7 +304,6 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
                          '(it stood in for what a later block explains)')
         if dropped:
             findings = [f for f in findings if f.mechanism not in dropped]
-            _refresh_values(findings, mechs, current, ctx, v_orig)
             loc = locate(t, v_orig, y, current.prediction, sigma, n_train, ctx.period_s)
     withdrawn: list[str] = []   # claims that the wider chain alone does as well as
     if findings:
@@ -316,6 +315,7 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
             notes.append(withdrawn_note(ids, *wider, data))
             findings, current, withdrawn = [], wider[0], ids
             loc = locate(t, v_orig, y, current.prediction, sigma, n_train, ctx.period_s)
+    _refresh_values(findings, mechs, current, ctx, v_orig)      # the values the set holds
     _final_corrections(findings, mechs, current, ctx, v_orig)
     final_loc = loc if current is not baseline else loc0
     gain_call(findings, final_loc, {m.id for m in mechs})
@@ -435,7 +435,7 @@ def _choose(comps: list[Comparison], data: Data, criteria, blocked: BlockedCV,
 
 def _refresh_values(findings: list[Finding], mechs: list[Mechanism], final: FitResult,
                     ctx: Context, command: np.ndarray) -> None:
-    """Each finding's values and words from ``final`` (after a block was withdrawn)."""
+    """Each finding's values and words from ``final``: the refitted chain the set holds."""
     info = _info(final, ctx, command)
     by_id = {m.id: m for m in mechs}
     for f in findings:

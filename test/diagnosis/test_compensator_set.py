@@ -170,3 +170,38 @@ def test_blocks_that_map_the_travel_say_so():
         assert m.maps_travel == overrides, mid
     assert MECHANISMS['static_nonlinearity'].maps_travel
     assert not MECHANISMS['friction'].maps_travel
+
+
+def test_the_diagnosis_set_says_its_schedule_is_referred_to_the_record_start():
+    """Its words and values agree: gain 1 and offset 0 at the start (the set holds there).
+
+    Before, ``hyst-id diagnose --params-out`` printed ``gain_reference = 1.124`` (the
+    finding's) and wrote 1.0.
+    """
+    corr = {'augment.gain_law': 'linear', 'augment.gain_rate_per_s': 0.002747,
+            'augment.gain_centre': 346.8, 'augment.gain_reference': 1.124}
+    finding = {'mechanism': 'gain_drift', 'compensation': {'correction': corr}}
+    aug, applied = augmentation_from_findings([finding], 90.0, model_from='diagnosis')
+    assert aug.gain_reference == 1.0
+    assert 'gain_reference = 1' in applied[0][1] and '1.124' not in applied[0][1]
+    aug, applied = augmentation_from_findings([finding], 90.0)    # an identified set's
+    assert aug.gain_reference == pytest.approx(1.124) and '1.124' in applied[0][1]
+
+
+@pytest.mark.slow
+def test_each_finding_reports_the_values_of_the_set_written():
+    """A finding's values come from the final chain, not from its round (two findings).
+
+    Before, on the cylinder at 7 bar the report said "predict 0.598 s ahead" (round 1)
+    and the set written predicted 0.6393 s (refitted with round 2's block). Here
+    (measured at this commit) ``supply_decay`` is fitted at 244.5 s in its round and
+    refitted at 247.9 s with ``dead_time``.
+    """
+    d = diagnose(_recording(0, channel='pressure', delay_s=0.5, rate=0.004),
+                 settings=replace(SETTINGS, max_mechanisms=2))
+    assert [f.mechanism for f in d.findings] == ['supply_decay', 'dead_time']
+    _, aug, applied = compensator_set(d)
+    decay, delay = d.findings
+    assert decay.params['time_constant_s'].value == pytest.approx(1 / aug.gain_rate_per_s)
+    assert delay.params['delay_s'].value == pytest.approx(aug.dead_time_s)
+    assert f'dead_time_s = {aug.dead_time_s:.4g}' in applied[1][1]
