@@ -146,6 +146,11 @@ def _progress_bar(args: argparse.Namespace, settings,
             bar.set_postfix_str(f'hopping {jump + 1}/{jumps}: %e_r {er:.3f}' if jump < jumps
                                 else f'hopped: %e_r {er:.3f}')
 
+    def restart(what: str) -> None:     # identify tries the record from its first reversal
+        bar.reset(total=len(settings.seeds))
+        bar.set_description(what)
+
+    progress.restart = restart
     progress.close = bar.close          # the caller's, after identify: hopping and the
     #                                     global phase follow the seeds, and may end early
     progress.hopping = hopping          # basin hopping between the seeds and the global phase

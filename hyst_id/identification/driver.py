@@ -218,7 +218,9 @@ def identify(recording: Recording, *, spec: ChainSpec | None = None,
         then counts the most global runs there can be). If it has an attribute
         ``hopping``, that is called as ``progress.hopping(jump, jumps,
         er_percent)`` before each jump of basin hopping and at its end
-        (``jump == jumps``).
+        (``jump == jumps``). If it has ``restart``, that is called with a few
+        words before the start-state retry's probe and again before its full
+        run (``IdentifySettings.start_state``), whose seeds count from the start.
     on_generation : callable, optional
         Called as ``on_generation(seed, restart, generation, er_percent)``
         after every GAASS generation, when the seeds run in this process
@@ -242,10 +244,13 @@ def identify(recording: Recording, *, spec: ChainSpec | None = None,
         return ident
     # a start inside the play or loop (see start_state): a short probe from the first reversal
     rest, before = rec.window(k, rec.n_samples), ident.er_percent / ident.noise_floor_percent
+    restart = getattr(progress, 'restart', lambda what: None)
+    restart('probing from the first reversal')
     probe = _identify(rest, spec, replace(full, seeds=full.seeds[:2], global_runs=0, hops=0),
                       None, None, should_stop)
     if not probe.er_percent / probe.noise_floor_percent * FIT_FACTOR < before:
         return ident
+    restart('GAASS seeds, from the first reversal')
     again = _identify(rest, spec, full, progress, on_generation, should_stop)
     after = again.er_percent / again.noise_floor_percent
     again.warnings.insert(0, left_out_note(rec.t_s, k, before, after))

@@ -61,7 +61,14 @@ def _recording(seed: int, rest_s: float, inside: bool) -> Recording:
 
 @pytest.mark.parametrize('seed', [0, 1])
 def test_a_start_inside_the_play_is_left_out_and_the_rest_fits_to_the_floor(seed):
-    ident = identify(_recording(seed, 10.0, inside=True), settings=SETTINGS)
+    said: list[str] = []
+
+    def progress(done, total, run):
+        pass
+
+    progress.restart = said.append          # as the CLI's bar: it starts again, says why
+    ident = identify(_recording(seed, 10.0, inside=True), settings=SETTINGS, progress=progress)
+    assert said == ['probing from the first reversal', 'GAASS seeds, from the first reversal']
     assert ident.er_percent <= 1.2 * ident.noise_floor_percent, ident.warnings
     assert 'are left out of the fit' in ident.warnings[0], ident.warnings
     assert 'inside its play or loop' in ident.warnings[0]
