@@ -100,6 +100,7 @@ def main() -> int:
             print(f'  note: {note}')
         if args.figures:
             name = Path(rec.source).stem
+            Path(args.figures).mkdir(parents=True, exist_ok=True)
             path = plot_diagnosis(d, Path(args.figures) / f'real_{name}.png', dpi=72)
             print(f'  figure: {path}')
     return 0
