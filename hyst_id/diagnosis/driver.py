@@ -442,7 +442,9 @@ def _refresh_values(findings: list[Finding], mechs: list[Mechanism], final: FitR
         m = by_id.get(f.mechanism)
         if m is None or m.id not in final.model.slices:
             continue
-        f.params = m.describe(final.model.theta(final.p, m.id), final.coef, info, ctx)
+        own = dict(info, er_before=f.er_holdout_before_percent,   # its round's, as reported
+                   er_after=f.er_holdout_after_percent)
+        f.params = m.describe(final.model.theta(final.p, m.id), final.coef, own, ctx)
         f.explanation = m.explain(f.params, f.where, ctx)
         f.compensation['how'] = m.compensation_note(f.params, ctx)
 
@@ -481,8 +483,7 @@ def range_note(v: np.ndarray, n_train: int, n_judged: int | None = None) -> list
         note = (f'the held-out command reaches {lo_h:.4g} to {hi_h:.4g}, beyond the training '
                 f'range {lo_t:.4g} to {hi_t:.4g}: held-out errors there are extrapolation of '
                 'the model, not necessarily missing physics')
-        n_ho = v.size - n_train
-        if n_judged is not None and n_judged < n_ho:
+        if n_judged is not None and n_judged < (n_ho := v.size - n_train):
             note += (f'; the blocks were judged on the first {n_judged} of {n_ho} held-out '
                      'samples, before the command first leaves the training range')
         return [note]
@@ -496,12 +497,11 @@ def level_note(y: np.ndarray, n_train: int) -> list[str]:
     :func:`range_note` already names the likelier cause).
     """
     share, lo, hi, lo_h, hi_h = level_excursion(y, n_train)
-    if share < 0.2:
-        return []
-    return [f'{100 * share:.0f} % of the held-out measurement lies beyond the levels of the '
-            f'training part ({lo_h:.4g} to {hi_h:.4g} against {lo:.4g} to {hi:.4g}): an end '
-            'stop or plateau reached only later, or a drift; blocks fitted on the training '
-            'part were never shown those levels, so the split can leave them undecided']
+    return [] if share < 0.2 else [
+        f'{100 * share:.0f} % of the held-out measurement lies beyond the levels of the '
+        f'training part ({lo_h:.4g} to {hi_h:.4g} against {lo:.4g} to {hi:.4g}): an end '
+        'stop or plateau reached only later, or a drift; blocks fitted on the training '
+        'part were never shown those levels, so the split can leave them undecided']
 
 
 def _judged(data: Data, baseline: FitResult, final: FitResult) -> dict:
