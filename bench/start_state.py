@@ -14,9 +14,10 @@
 
 """Recordings whose actuator starts inside its play: identify with and without the start.
 
-A play operator written here (``y = 2 play(u, 0.8) + 1``, noise 0.01), the
-command resting at 0 for ``rest`` seconds (the output mid-play, or on the
-rising edge), then 40 s of a sine of varying amplitude at 100 Hz. For each
+A play operator written apart from the package (``test/play_reference.py``:
+``y = 2 play(u, 0.8) + 1``, noise 0.01), the command resting at 0 for
+``rest`` seconds (the output mid-play, or on the rising edge), then 40 s of
+a sine of varying amplitude at 100 Hz. For each
 case and noise seed: the whole record's fit over the noise floor (from the
 warning, when the start was left out) and the fit that identify reports.
 See ``hyst_id/identification/start_state.py``. About two minutes.
@@ -27,31 +28,17 @@ Usage: ``python bench/start_state.py [--seeds 0 1 2]``
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 import re
+import sys
 
-import numpy as np
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / 'test'))
+sys.path.insert(0, str(ROOT))
 
-from hyst_id.identification import identify, IdentifySettings
-from hyst_id.io.recording import Recording
+from hyst_id.identification import identify, IdentifySettings  # noqa: E402
 
-
-def play(u: np.ndarray, half_width: float, y0: float) -> np.ndarray:
-    """A play (backlash) operator of half width ``half_width`` from output ``y0``."""
-    out, y = np.empty_like(u), y0
-    for i, x in enumerate(u):
-        y = min(max(y, x - half_width), x + half_width)
-        out[i] = y
-    return out
-
-
-def recording(seed: int, rest_s: float, inside: bool) -> Recording:
-    """The case's recording (see the module)."""
-    t = np.arange(0.0, rest_s + 40.0, 0.01)
-    s = t - rest_s
-    u = np.where(s < 0, 0.0, 5 * np.sin(2 * np.pi * 0.2 * s) * (0.6 + 0.4 * np.sin(
-        2 * np.pi * 0.013 * s)))
-    y = 2.0 * play(u, 0.8, 0.0 if inside else -0.8) + 1.0
-    return Recording(t, u, y + np.random.default_rng(seed).normal(0, 0.01, t.size), 'position')
+from play_reference import rest_then_sine  # noqa: E402, I100
 
 
 def main() -> None:
@@ -61,7 +48,7 @@ def main() -> None:
     settings = IdentifySettings(seeds=(0, 1, 2), workers=1)
     for rest, inside in ((20.0, True), (0.0, True), (20.0, False)):
         for seed in args.seeds:
-            ident = identify(recording(seed, rest, inside), settings=settings)
+            ident = identify(rest_then_sine(seed, rest, inside, sine_s=40.0), settings=settings)
             ratio = ident.er_percent / ident.noise_floor_percent
             left = next((w for w in ident.warnings if 'left out of the fit' in w), '')
             whole = re.search(r'with them the fit was ([0-9.]+) x', left)

@@ -14,7 +14,7 @@
 
 """A recording whose actuator rests inside its play at the start (independent reviewer's case).
 
-The data come from a play operator written here (not the package's backlash):
+The data come from a play operator written apart from the package (``test/play_reference.py``):
 ``y = 2 play(u, 0.8) + 1`` with white noise of 0.01, the command resting at 0
 (the output in the middle of the play) for 10 s, then a sine of varying
 amplitude. Before the fix the whole record was fitted: on the reviewer's own
@@ -30,33 +30,19 @@ from __future__ import annotations
 from dataclasses import replace
 
 import numpy as np
+from play_reference import rest_then_sine
 import pytest
 
 from hyst_id.diagnosis import DiagnoseSettings
 from hyst_id.diagnosis.baseline import _identify_base
 from hyst_id.identification import identify, IdentifySettings
 from hyst_id.identification.start_state import refit_start
-from hyst_id.io.recording import Recording
 
 SETTINGS = IdentifySettings(seeds=(0, 1, 2), workers=1)
 
 
-def _play(u: np.ndarray, half_width: float, y0: float) -> np.ndarray:
-    out, y = np.empty_like(u), y0
-    for i, x in enumerate(u):
-        y = min(max(y, x - half_width), x + half_width)
-        out[i] = y
-    return out
-
-
-def _recording(seed: int, rest_s: float, inside: bool) -> Recording:
-    t = np.arange(0.0, rest_s + 30.0, 0.01)
-    s = t - rest_s
-    u = np.where(s < 0, 0.0, 5 * np.sin(2 * np.pi * 0.2 * s) * (0.6 + 0.4 * np.sin(
-        2 * np.pi * 0.013 * s)))
-    y0 = 0.0 if inside else -0.8               # mid-play, or on the rising edge
-    y = 2.0 * _play(u, 0.8, y0) + 1.0 + np.random.default_rng(seed).normal(0, 0.01, t.size)
-    return Recording(t, u, y, 'position')
+def _recording(seed: int, rest_s: float, inside: bool):
+    return rest_then_sine(seed, rest_s, inside, sine_s=30.0)
 
 
 @pytest.mark.parametrize('seed', [0, 1])
