@@ -198,7 +198,8 @@ def test_each_finding_reports_the_values_of_the_set_written():
     refitted at 247.9 s with ``dead_time``.
     """
     d = diagnose(_recording(0, channel='pressure', delay_s=0.5, rate=0.004),
-                 settings=replace(SETTINGS, max_mechanisms=2))
+                 settings=replace(SETTINGS, max_mechanisms=2, mechanisms=(
+                     'dead_time', 'sensor_lag', 'supply_decay', 'offset_drift')))
     assert [f.mechanism for f in d.findings] == ['supply_decay', 'dead_time']
     _, aug, applied = compensator_set(d)
     decay, delay = d.findings
