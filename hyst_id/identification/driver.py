@@ -239,8 +239,9 @@ def identify(recording: Recording, *, spec: ChainSpec | None = None,
     rec = validate_recording(recording)
     ident = _identify(rec, spec, settings, progress, on_generation, should_stop)
     full = settings or IdentifySettings()
-    k = refit_start(rec.command, ident.er_percent, ident.noise_floor_percent)
-    if k is None or not full.start_state:
+    k = (refit_start(rec.command, ident.er_percent, ident.noise_floor_percent)
+         if full.start_state else None)
+    if k is None:
         return ident
     # a start inside the play or loop (see start_state): a short probe from the first reversal
     rest, before = rec.window(k, rec.n_samples), ident.er_percent / ident.noise_floor_percent
@@ -248,11 +249,11 @@ def identify(recording: Recording, *, spec: ChainSpec | None = None,
     restart('probing from the first reversal')
     probe = _identify(rest, spec, replace(full, seeds=full.seeds[:2], global_runs=0, hops=0),
                       None, None, should_stop)
-    if not probe.er_percent / probe.noise_floor_percent * FIT_FACTOR < before:
-        return ident
+    if not probe.er_percent * FIT_FACTOR < before * probe.noise_floor_percent:
+        return ident        # (also when the rest's floor is 0: nothing to judge by)
     restart('GAASS seeds, from the first reversal')
     again = _identify(rest, spec, full, progress, on_generation, should_stop)
-    after = again.er_percent / again.noise_floor_percent
+    after = again.er_percent / again.noise_floor_percent   # > 0: the probe's was
     again.warnings.insert(0, left_out_note(rec.t_s, k, before, after))
     return again
 

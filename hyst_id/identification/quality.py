@@ -61,6 +61,7 @@ __all__ = [
     'domain_edge_warnings',
     'fit_warnings',
     'floor_estimate_warnings',
+    'floor_says_nothing',
     'identification_warnings',
     'orientation_warnings',
     'parameter_scales',
@@ -165,11 +166,20 @@ def orientation_warnings(rec: Recording, sign: float = 1.0) -> list[str]:
     return out
 
 
+def floor_says_nothing(er_percent: float, floor_percent: float) -> bool:
+    """Whether a ratio of ``er_percent`` to the noise floor means nothing.
+
+    True when the floor is about 0 next to the fit (:data:`NOISE_FREE_RATIO`): a
+    noise-free or smoothed record, whose ratio only measures round-off.
+    """
+    return not er_percent < NOISE_FREE_RATIO * floor_percent
+
+
 def fit_warnings(ident: Identification) -> list[str]:
     """Warn about a fit above the noise floor and about seeds in other optima."""
     out = []
     floor = ident.noise_floor_percent
-    if ident.er_percent > 1e-9 and not ident.er_percent < NOISE_FREE_RATIO * floor:
+    if ident.er_percent > 1e-9 and floor_says_nothing(ident.er_percent, floor):
         out.append(f'the noise floor is about 0 (a noise-free or smoothed record) and the fit '
                    f'misses by %e_r {ident.er_percent:.4g}: the model misses part of the '
                    'response; look at the residual plot')

@@ -26,7 +26,7 @@ import numpy as np
 
 from hyst_id.identification import Identification
 from hyst_id.identification.chains import er_percent, param_units
-from hyst_id.identification.quality import NOISE_FREE_RATIO
+from hyst_id.identification.quality import floor_says_nothing
 from hyst_id.io.jsonable import jsonable
 from hyst_id.io.recording import Recording
 
@@ -96,7 +96,7 @@ def _num(value: float, width: int, decimals: int = 4) -> str:
 
 def _floor_ratio(er_percent: float, floor_percent: float) -> str:
     """The fit's ratio to its noise floor in words, or why there is none."""
-    if not floor_percent > 0.0 or er_percent > NOISE_FREE_RATIO * floor_percent:
+    if floor_says_nothing(er_percent, floor_percent):
         return ('(noise floor about 0: the record is noise-free or smoothed, so a ratio to it '
                 'says nothing)')
     return f'({er_percent / floor_percent:.2f} x noise floor)'

@@ -34,7 +34,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from hyst_id.identification.quality import FIT_FACTOR, NOISE_FREE_RATIO
+from hyst_id.identification.quality import FIT_FACTOR, floor_says_nothing
 from hyst_id.signals.reversals import reversal_indices
 
 __all__ = ['MIN_BEFORE', 'MIN_KEEP', 'left_out_note', 'refit_start']
@@ -58,13 +58,14 @@ def refit_start(command: np.ndarray, er_percent: float, floor_percent: float) ->
     Returns
     -------
     int or None
-        None when the fit is within :data:`FIT_FACTOR` of the floor or
-        :data:`~hyst_id.identification.quality.NOISE_FREE_RATIO` times above it, the
+        None when the fit is within :data:`FIT_FACTOR` of the floor or the
+        floor says nothing (:func:`~hyst_id.identification.quality.floor_says_nothing`), the
         command reverses fewer than three times, fewer than
         :data:`MIN_BEFORE` samples lie before the first reversal, or less
         than :data:`MIN_KEEP` of them after it.
     """
-    if not FIT_FACTOR * floor_percent < er_percent < NOISE_FREE_RATIO * floor_percent:
+    if (not FIT_FACTOR * floor_percent < er_percent
+            or floor_says_nothing(er_percent, floor_percent)):
         return None     # at the floor, or a noise-free record (no ratio to judge by)
     index, _ = reversal_indices(np.asarray(command, dtype=float))
     if index.size < 3:
