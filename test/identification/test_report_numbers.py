@@ -21,6 +21,7 @@ Before: fixed four decimals printed every slope of a recording in metres as
 from __future__ import annotations
 
 import numpy as np
+from play_reference import rest_then_sine
 
 from hyst_id.identification import identify, IdentifySettings
 from hyst_id.identification.report import _floor_ratio, _num, format_table
@@ -50,7 +51,7 @@ def test_a_noise_free_record_gets_no_ratio_in_its_warning():
     y = np.round(2.0 * np.clip(v, -3, 3) + 0.2 * np.sin(2 * np.pi * 1.3 * t), 9)  # no noise
     ident = identify(Recording(t, v, y, 'position'),
                      settings=IdentifySettings(seeds=(0,), workers=1, global_runs=0, hops=0))
-    assert ident.er_percent > 1000 * ident.noise_floor_percent        # the case itself
+    assert ident.er_percent > 1000 * ident.noise_floor_percent   # the case: 1.55e4-1.57e4 x
     assert any('noise floor is about 0' in w for w in ident.warnings), ident.warnings
     assert not any('x the noise floor' in w for w in ident.warnings), ident.warnings
     assert 'noise-free' in format_table(ident)
@@ -68,17 +69,22 @@ def test_a_recording_in_micrometres_prints_its_slopes():
 
 
 def test_a_fit_below_what_noise_allows_says_the_floor_is_too_high():
-    """50 samples, 25 a loop (the reviewer's case gave 0.20 x): the floor estimate is inflated."""
+    """50 samples, 17 a loop (the reviewer's case gave 0.20 x): the floor estimate is inflated.
+
+    Measured over noise seeds 0-4 and round-off probes none, 1 and 2: 0.135-0.296 x the
+    floor (the warning's bound here is 0.8 sqrt(1 - 13/50) = 0.69). At 25 samples a loop it
+    was 0.50-0.65 x, too near that bound to rely on.
+    """
     t = np.arange(50) * 0.02
-    v = 5 * np.sin(2 * np.pi * 2.0 * t)
+    v = 5 * np.sin(2 * np.pi * 3.0 * t)
     rng = np.random.default_rng(0)
     settings = IdentifySettings(seeds=(0,), workers=1, global_runs=0, hops=0)
     coarse = identify(Recording(t, v, 2.0 * np.clip(v, -3, 3) + rng.normal(0, 0.01, t.size),
                                 'position'), settings=settings)
-    assert coarse.er_percent < 0.65 * coarse.noise_floor_percent    # the case itself
+    assert coarse.er_percent < 0.45 * coarse.noise_floor_percent    # the case itself
     assert any('below what noise allows' in w for w in coarse.warnings), coarse.warnings
-    t = np.arange(2000) * 0.01
-    v = 5 * np.sin(2 * np.pi * 0.2 * t)
-    fine = identify(Recording(t, v, 2.0 * np.clip(v, -3, 3) + rng.normal(0, 0.01, t.size),
-                              'position'), settings=settings)
+    # a well-sampled loop fitted at its floor (0.974-0.995 x over noise seeds 0-2 and
+    # probes none, 1, 2; the bound there is 0.797 x): no warning
+    fine = identify(rest_then_sine(0, 0.0, inside=False, sine_s=20.0), settings=settings)
+    assert fine.er_percent < 1.1 * fine.noise_floor_percent
     assert not any('below what noise allows' in w for w in fine.warnings), fine.warnings
