@@ -171,7 +171,7 @@ def test_bad_params_file_is_a_one_line_config_error(ros_domain, tmp_path):
     bad_value.write_text('compensator:\n  ros__parameters:\n' + ''.join(
         f'    {k}: {float(v)!r}\n' for k, v in {**PAPER, 'c_l': 0.9}.items()))
     bad_type = tmp_path / 'type.yaml'
-    bad_type.write_text('compensator:\n  ros__parameters:\n    max_command: 20\n')
+    bad_type.write_text('compensator:\n  ros__parameters:\n    max_command: high\n')
     for path, needle in ((bad_value, 'not proper'), (bad_type, 'double')):
         context = rclpy.Context()
         rclpy.init(args=['--ros-args', '--params-file', str(path)], context=context)
@@ -181,6 +181,30 @@ def test_bad_params_file_is_a_one_line_config_error(ros_domain, tmp_path):
             assert '\n' not in str(info.value)
         finally:
             context.try_shutdown()
+
+
+def test_a_whole_number_for_a_double_is_taken(ros_domain, tmp_path, ctx):
+    path = tmp_path / 'whole.yaml'
+    path.write_text('compensator:\n  ros__parameters:\n    max_command: 19\n')
+    context = rclpy.Context()
+    rclpy.init(args=['--ros-args', '--params-file', str(path), '-p', 'min_command:=5'],
+               context=context)
+    try:
+        comp = Compensator(context=context)
+        assert (comp.p('max_command'), comp.p('min_command')) == (19.0, 5.0)
+        assert isinstance(comp.p('max_command'), float)
+        comp.destroy_node()
+    finally:
+        context.try_shutdown()
+    live = _make(ctx, Compensator)
+    assert _set(live, max_command=18).successful
+    assert live.p('max_command') == 18.0 and isinstance(live.p('max_command'), float)
+    result = _set(live, max_command=3)  # below min_command: validated like a double
+    assert not result.successful, result.reason
+    # an integer parameter still refuses a double, and a double a string
+    ident = _make(ctx, Identifier)
+    assert not _set(ident, pop_size=40.0).successful
+    assert not _set(live, max_command='19').successful
 
 
 def test_a_set_of_an_actuator_outside_4_20_brings_its_command_limits(ros_domain, tmp_path):

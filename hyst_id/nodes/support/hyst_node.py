@@ -29,6 +29,7 @@ from rclpy.exceptions import (
     ParameterException,
 )
 from rclpy.node import Node
+from rclpy.parameter import Parameter
 
 from hyst_id.errors import ConfigError
 from hyst_id.io.topics import NODE_STREAM_KEYS, TOPIC_FILE_KEYS
@@ -42,7 +43,7 @@ from hyst_id.nodes.support.ros import (
     try_publish,
 )
 
-__all__ = ['HystNode', 'unknown_overrides']
+__all__ = ['HystNode', 'unknown_overrides', 'widened_integers']
 
 _TYPE_NAMES = {bool: 'a bool', int: 'an integer', float: 'a double', str: 'a string',
                list: 'an array'}
@@ -54,6 +55,18 @@ STREAM_TYPE_KEYS = tuple(sorted(f'topics.{k}' for k in NODE_STREAM_KEYS))
 #: Parameters rclpy itself reads, and prefixes of parameter families it owns.
 _ROS_OWN = frozenset({'use_sim_time', 'start_type_description_service'})
 _ROS_OWN_PREFIXES = ('qos_overrides.',)
+
+
+def widened_integers(params: Iterable[Parameter], float_names: frozenset[str]
+                     ) -> list[tuple[str, Parameter]]:
+    """``(name, double parameter)`` for each integer given to a double parameter.
+
+    rclpy refuses ``max_command: 20`` for a double; the value is the same
+    number, so it is taken as ``20.0``. Integer arrays stay refused.
+    """
+    return [(prm.name, Parameter(prm.name, Parameter.Type.DOUBLE, float(prm.value)))
+            for prm in params
+            if prm.name in float_names and prm.type_ == Parameter.Type.INTEGER]
 
 
 def unknown_overrides(overrides: Iterable[str], declared: Iterable[str]) -> list[str]:
@@ -112,6 +125,14 @@ class HystNode(Node):
         unknown = set(defaults) - set(self._param_table)
         if unknown:
             raise ConfigError(f'{node_name}: unknown parameter defaults {sorted(unknown)}')
+        self._float_names = frozenset(
+            p.name for p in params
+            if isinstance(defaults.get(p.name, p.default), float))
+        # a whole number for a double (``max_command: 20``, ``-p gain:=1``) is the same value
+        overrides = getattr(self, '_parameter_overrides', {})
+        for name, given in widened_integers(overrides.values(), self._float_names):
+            overrides[name] = given
+        self.add_pre_set_parameters_callback(self._widen_integers)
         for p in params:
             default = defaults.get(p.name, p.default)
             try:
@@ -182,6 +203,10 @@ class HystNode(Node):
                 if reason:
                     return reason
         return self.validate_params(values, changed)
+
+    def _widen_integers(self, params: list) -> list:
+        widened = dict(widened_integers(params, self._float_names))
+        return [widened.get(prm.name, prm) for prm in params]
 
     def _on_set_parameters(self, params: list) -> SetParametersResult:
         values = self.param_values()
