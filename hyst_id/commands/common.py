@@ -106,6 +106,7 @@ def add_settings_arguments(parser: argparse.ArgumentParser, identify: bool = Tru
 
 def load_recording(args: argparse.Namespace) -> Recording:
     """Read and validate the recording named on the command line."""
+    from hyst_id.io.csv_reader import TIME_UNIT_NOTE
     from hyst_id.io.readers import read_recording
     from hyst_id.io.topics import load_topic_file
 
@@ -114,8 +115,12 @@ def load_recording(args: argparse.Namespace) -> Recording:
         print(f'note: {args.params}: only topics and fields are read here; node parameters '
               f'{", ".join(unused[:8])}{" ..." if len(unused) > 8 else ""} are not used (give '
               'GAASS settings and domains as flags)', file=sys.stderr)
-    return read_recording(args.recording, args.channel, topics=topics,
-                          columns=parse_columns(args.columns), time_scale=args.time_scale)
+    rec = read_recording(args.recording, args.channel, topics=topics,
+                         columns=parse_columns(args.columns), time_scale=args.time_scale)
+    for note in rec.notes:
+        if note.startswith(TIME_UNIT_NOTE):
+            print(f'note: {note[len(TIME_UNIT_NOTE):].strip()}', file=sys.stderr)
+    return rec
 
 
 def parse_columns(text: str | None) -> tuple[int | str, ...] | None:

@@ -23,18 +23,55 @@ from __future__ import annotations
 from collections.abc import Sequence
 import math
 from pathlib import Path
+import re
 
 import numpy as np
 
 from hyst_id.errors import ConfigError, MissingTopicError, RecordingError
 from hyst_id.io.recording import Recording
 
-__all__ = ['CSV_SUFFIXES', 'DEFAULT_COLUMNS', 'read_csv']
+__all__ = ['CSV_SUFFIXES', 'DEFAULT_COLUMNS', 'TIME_UNIT_NOTE', 'read_csv', 'time_unit_hint']
 
 #: File suffixes read as delimited text.
 CSV_SUFFIXES = ('.csv', '.txt', '.tsv')
 #: Header names read by default: time in seconds, command, measurement.
 DEFAULT_COLUMNS = ('t', 'command', 'measurement')
+#: First words of the note :func:`time_unit_hint` adds (the CLI prints it).
+TIME_UNIT_NOTE = 'time unit:'
+# header words naming a time unit other than seconds, and the factor to seconds
+_TIME_UNITS = (('ms|msec|millis|milliseconds?', 1e-3), ('us|usec|µs|micros|microseconds?', 1e-6),
+               ('ns|nsec|nanos|nanoseconds?', 1e-9), ('min|minutes?', 60.0))
+# header words of a sample counter, which has no unit to doubt
+_COUNTER_WORDS = frozenset({'index', 'idx', 'sample', 'samples', 'n', 'k', 'step'})
+#: A median sample interval from which seconds are doubtful for an actuator record.
+_SLOW_INTERVAL_S = 0.5
+
+
+def time_unit_hint(label: str, t: np.ndarray) -> str | None:
+    """Why the time column ``label`` (read as seconds) may be in another unit, or None.
+
+    The header's words decide when they name a unit (``t_ms``, ``time [us]``);
+    a header with none (or a column index) is doubted when the median interval is at
+    least 0.5 s, slow for an actuator record; a counter (``index``,
+    ``sample``) is not. The words end with the
+    ``--time-scale`` to give.
+    """
+    words = re.split(r'[^a-zµ]+', label.lower())
+    if any(w in _COUNTER_WORDS for w in words):
+        return None
+    for pattern, factor in _TIME_UNITS:
+        if any(re.fullmatch(pattern, w) for w in words):
+            return (f'{TIME_UNIT_NOTE} the time column {label!r} reads like '
+                    f'{pattern.split("|")[0]}, but is read as seconds; if so, give '
+                    f'--time-scale {factor:g}')
+    steps = np.diff(t[np.isfinite(t)])
+    steps = steps[steps > 0]
+    if steps.size and float(np.median(steps)) >= _SLOW_INTERVAL_S \
+            and not any(w in ('s', 'sec', 'secs', 'seconds', 'second') for w in words):
+        return (f'{TIME_UNIT_NOTE} the time column {label!r} is read as seconds: a median '
+                f'sample interval of {float(np.median(steps)):g} s; if it holds '
+                'milliseconds, give --time-scale 0.001')
+    return None
 
 
 def _is_number(cell: str) -> bool:
@@ -46,7 +83,7 @@ def _is_number(cell: str) -> bool:
 
 
 def read_csv(path: str | Path, channel: str, *,
-             columns: Sequence[str | int] = DEFAULT_COLUMNS, time_scale: float = 1.0,
+             columns: Sequence[str | int] = DEFAULT_COLUMNS, time_scale: float | None = 1.0,
              delimiter: str | None = None, command_unit: str = '',
              measurement_unit: str = '') -> Recording:
     """Read a recording from delimited text, without validating or reordering it.
@@ -61,8 +98,10 @@ def read_csv(path: str | Path, channel: str, *,
     columns : sequence of str or int
         Time, command and measurement columns: header names, or 0-based
         indices (needed for headerless files).
-    time_scale : float
-        Factor turning the time column into seconds (0.001 for ms).
+    time_scale : float or None
+        Factor turning the time column into seconds (0.001 for ms). None
+        reads seconds and adds a :func:`time_unit_hint` note when the
+        column looks like another unit.
     delimiter : str, optional
         Cell separator; default comma if the first line has one, else
         semicolon if it has one, else runs of whitespace.
@@ -90,6 +129,8 @@ def read_csv(path: str | Path, channel: str, *,
     if len(columns) != 3:
         raise ConfigError(f'columns must name 3 columns (time, command, measurement), '
                           f'got {columns!r}')
+    given_scale = time_scale is not None
+    time_scale = 1.0 if time_scale is None else time_scale
     if not (isinstance(time_scale, (int, float)) and math.isfinite(time_scale)
             and time_scale > 0):
         raise ConfigError(f'time_scale must be a positive number, got {time_scale!r}')
@@ -146,6 +187,8 @@ def read_csv(path: str | Path, channel: str, *,
                                      f'at line {lineno} of {path}') from None
     note = (f'columns: t_s = {labels[0]} x {time_scale:g}, command = {labels[1]}, '
             f'measurement = {labels[2]}')
+    hint = None if given_scale else time_unit_hint(labels[0], data[:, 0])
     return Recording(t_s=data[:, 0] * float(time_scale), command=data[:, 1],
                      measurement=data[:, 2], channel=channel, command_unit=command_unit,
-                     measurement_unit=measurement_unit, source=str(path), notes=(note,))
+                     measurement_unit=measurement_unit, source=str(path),
+                     notes=(note,) + ((hint,) if hint else ()))

@@ -89,7 +89,7 @@ def read_recording(path: str | Path, channel: str, *,
                    else TopicConfig.for_channel(channel, topics))
             units = (cfg.command_unit, cfg.measurement_unit)
         rec = read_csv(path, channel, columns=DEFAULT_COLUMNS if columns is None else columns,
-                       time_scale=1.0 if time_scale is None else time_scale,
+                       time_scale=time_scale,
                        command_unit=units[0], measurement_unit=units[1])
     else:
         raise RecordingError(f'unrecognised recording format: {path} (expected a bag '

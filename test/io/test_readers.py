@@ -26,7 +26,7 @@ import pytest
 
 from hyst_id.errors import ConfigError, MissingTopicError, NoExcitationError, RecordingError
 from hyst_id.io.bag import BagWriter, iter_bag_messages, write_recording_bag
-from hyst_id.io.csv_reader import read_csv
+from hyst_id.io.csv_reader import read_csv, TIME_UNIT_NOTE
 from hyst_id.io.mcap_reader import read_mcap
 from hyst_id.io.readers import read_recording
 from hyst_id.io.recording import Recording
@@ -384,6 +384,45 @@ def test_headerless_ms_csv(tmp_path: Path) -> None:
     np.testing.assert_allclose(got.t_s[:3], [0.0, 0.01, 0.02])
 
 
+def _unit_notes(rec: Recording) -> list[str]:
+    return [n for n in rec.notes if n.startswith(TIME_UNIT_NOTE)]
+
+
+@pytest.mark.parametrize('header, step, scale, says', [
+    ('time_ms', 10, None, '--time-scale 0.001'),      # the header names the unit
+    ('t [us]', 1000, None, '--time-scale 1e-06'),
+    ('t', 10, None, 'median sample interval of 10 s'),  # no unit named, slow for an actuator
+    ('t', 0.01, None, None),                          # seconds at 100 Hz
+    ('t_s', 10, None, None),                          # seconds named: believed
+    ('index', 1, None, None),                         # a sample counter
+    ('time_ms', 10, 1e-3, None),                      # the scale given
+])
+def test_time_unit_hint_for_a_csv_read_as_seconds(
+        tmp_path: Path, header: str, step: float, scale: float | None, says: str | None) -> None:
+    path = _write(tmp_path / 'run.csv', f'{header},command,measurement\n' + ''.join(
+        f'{step * i!r},{np.sin(i / 9):.6f},{np.cos(i / 9):.6f}\n' for i in range(200)))
+    got = read_recording(path, 'position', columns=(header, 'command', 'measurement'),
+                         time_scale=scale)
+    notes = _unit_notes(got)
+    if says is None:
+        assert notes == []
+    else:
+        assert len(notes) == 1 and says in notes[0] and repr(header) in notes[0], notes
+
+
+def test_time_unit_hint_reaches_the_cli(tmp_path: Path, capsys) -> None:
+    import argparse
+    from hyst_id.commands.common import load_recording
+    path = _write(tmp_path / 'run.csv', 't,command,measurement\n' + ''.join(
+        f'{10 * i},{np.sin(i / 9):.6f},{np.cos(i / 9):.6f}\n' for i in range(200)))
+    args = argparse.Namespace(recording=str(path), channel='position', params=None,
+                              columns=None, time_scale=None)
+    load_recording(args)
+    assert 'note: the time column' in capsys.readouterr().err
+    load_recording(argparse.Namespace(**{**vars(args), 'time_scale': 1e-3}))
+    assert 'time column' not in capsys.readouterr().err
+
+
 @pytest.mark.parametrize('name, rows, duration_s', [
     ('Circle_1bar.csv', 7139, 73.508), ('Circle_3bar.csv', 7834, 83.239),
     ('Circle_7bar.csv', 8720, 89.999)])
@@ -396,6 +435,9 @@ def test_real_pneumatic_csv(name: str, rows: int, duration_s: float) -> None:
     # gap at 3 bar), so every row is kept and validation passes as is.
     assert got.n_samples == rows
     assert got.duration_s == pytest.approx(duration_s)
+    assert _unit_notes(got) == []
+    # read as seconds, the file's 10 ms steps are doubted
+    assert _unit_notes(read_recording(path, 'position', columns=(0, 4, 6)))
     assert np.diff(got.t_s).min() >= 0.0099
     assert 30.0 < np.ptp(got.command) < 42.0          # piston stroke, mm
 
