@@ -46,7 +46,7 @@ class GainDrift(TimeGain):
     id = 'gain_drift'  # noqa: A003
     title = 'plant or sensor gain growing over time'
     physics = ('the sensitivity rises during the run (a sensor or amplifier warming up, '
-               'temperature), so the same travel reads more later in the run')
+               'temperature), so the same travel gives a larger reading later in the run')
     gain_law = 'linear'
     names = ('growth_per_s',)
     units = ('1/s',)
@@ -69,8 +69,8 @@ class GainDrift(TimeGain):
         """Words for a control engineer."""
         return (f'The gain grows with time: {values["gain_growth_percent"].value:.1f} % over '
                 f'the {ctx.duration_s:.0f} s record '
-                f'({values["growth_percent_per_s"].value:.3g} %/s): the same travel reads '
-                f'more {ctx.channel} later in the run, as when a sensor or its amplifier warms '
+                f'({values["growth_percent_per_s"].value:.3g} %/s): the same travel gives a '
+                'larger reading later in the run, as when a sensor or its amplifier warms '
                 'up. Let the sensor warm up before identifying, calibrate at operating '
                 'temperature, or track the gain online (tracking in the compensator).')
 
