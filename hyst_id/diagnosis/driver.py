@@ -75,16 +75,17 @@ from hyst_id.diagnosis.select import (
     hold_calls,
     round_record,
 )
+from hyst_id.diagnosis.split_notes import level_note, range_note
 from hyst_id.diagnosis.trial import try_all
 from hyst_id.errors import ConfigError, RecordingError
 from hyst_id.identification.chains import chain_spec, ChainSpec
 from hyst_id.io.recording import Recording, roundoff_probe, validate_part, validate_recording
 from hyst_id.signals.noise import floor_percent
 from hyst_id.signals.reversals import period_s
-from hyst_id.signals.split import inside_rows, level_excursion, split_index
+from hyst_id.signals.split import inside_rows, split_index
 
 __all__ = ['UNKNOWN_FACTOR', 'WHOLE_RECORD_FACTOR', 'diagnose', 'finding_from', 'gain_call',
-           'level_note', 'located_where', 'range_note']
+           'located_where']
 
 #: Held-out %e_r over the noise floor above which what is left counts as missing physics.
 UNKNOWN_FACTOR = 1.5
@@ -469,39 +470,6 @@ def _final_corrections(findings: list[Finding], mechs: list[Mechanism], final: F
         f.compensation['correction'] = (
             m.correction(model.theta(final.p, m.id), final.coef, info, ctx)
             if m.id in model.slices else {})
-
-
-def range_note(v: np.ndarray, n_train: int, n_judged: int | None = None) -> list[str]:
-    """A warning when the held-out command leaves the training range (extrapolation).
-
-    With ``n_judged`` (held-out samples the blocks were judged on, see
-    :func:`hyst_id.signals.split.inside_rows`) the note says which part decided.
-    """
-    lo_t, hi_t = float(np.min(v[:n_train])), float(np.max(v[:n_train]))
-    lo_h, hi_h = float(np.min(v[n_train:])), float(np.max(v[n_train:]))
-    if max(lo_t - lo_h, hi_h - hi_t) > 0.05 * (hi_t - lo_t):
-        note = (f'the held-out command reaches {lo_h:.4g} to {hi_h:.4g}, beyond the training '
-                f'range {lo_t:.4g} to {hi_t:.4g}: held-out errors there are extrapolation of '
-                'the model, not necessarily missing physics')
-        if n_judged is not None and n_judged < (n_ho := v.size - n_train):
-            note += (f'; the blocks were judged on the first {n_judged} of {n_ho} held-out '
-                     'samples, before the command first leaves the training range')
-        return [note]
-    return []
-
-
-def level_note(y: np.ndarray, n_train: int) -> list[str]:
-    """A note when a fifth or more of the held-out measurement lies beyond the training levels.
-
-    Made only when the held-out command stays inside its training range (else
-    :func:`range_note` already names the likelier cause).
-    """
-    share, lo, hi, lo_h, hi_h = level_excursion(y, n_train)
-    return [] if share < 0.2 else [
-        f'{100 * share:.0f} % of the held-out measurement lies beyond the levels of the '
-        f'training part ({lo_h:.4g} to {hi_h:.4g} against {lo:.4g} to {hi:.4g}): an end '
-        'stop or plateau reached only later, or a drift; blocks fitted on the training '
-        'part were never shown those levels, so the split can leave them undecided']
 
 
 def _judged(data: Data, baseline: FitResult, final: FitResult) -> dict:

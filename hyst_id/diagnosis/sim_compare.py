@@ -52,7 +52,7 @@ import numpy as np
 from scipy.optimize import minimize, minimize_scalar
 from threadpoolctl import threadpool_limits
 
-from hyst_id.diagnosis.driver import located_where, range_note
+from hyst_id.diagnosis.driver import located_where
 from hyst_id.diagnosis.locate import Localization, locate, noise_std
 from hyst_id.diagnosis.mechanisms import MECHANISMS, Quantity
 from hyst_id.diagnosis.result import DiagnoseSettings, Diagnosis, Finding
@@ -66,6 +66,7 @@ from hyst_id.diagnosis.select import (
     FitResult,
     round_record,
 )
+from hyst_id.diagnosis.split_notes import range_note
 from hyst_id.diagnosis.stick_events import bands_from_demand
 from hyst_id.errors import ConfigError, HystIdError, RecordingError
 from hyst_id.identification.chains import er_percent

@@ -53,7 +53,7 @@ def test_all_held_out_rows_when_the_command_stays_inside_or_leaves_at_once():
 
 def test_level_excursion_finds_a_held_out_plateau_the_training_part_never_reached():
     """The command stays inside, the response rises to a plateau only after the split."""
-    from hyst_id.diagnosis.driver import level_note
+    from hyst_id.diagnosis.split_notes import level_note
     from hyst_id.signals.split import level_excursion
     t = np.linspace(0.0, 20.0, 2000)
     rng = np.random.default_rng(1)
