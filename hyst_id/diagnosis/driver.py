@@ -49,6 +49,7 @@ and which features of the command and time carry it.
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Callable
 
 import numpy as np
@@ -76,6 +77,7 @@ from hyst_id.diagnosis.select import (
     round_record,
 )
 from hyst_id.diagnosis.split_notes import level_note, range_note
+from hyst_id.diagnosis.start_cut import start_cut
 from hyst_id.diagnosis.trial import try_all
 from hyst_id.errors import ConfigError, RecordingError
 from hyst_id.identification.chains import chain_spec, ChainSpec
@@ -195,6 +197,7 @@ def diagnose(recording: Recording, *, spec: ChainSpec | None = None,
 
 def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSettings,
               say: Callable[[str], None]) -> Diagnosis:
+    given_spec = spec
     rec = roundoff_probe(validate_recording(recording))
     mechs = get_mechanisms(settings.mechanisms, channel=rec.channel)
     t, v_orig, y = rec.t_s, rec.command, rec.measurement
@@ -229,6 +232,14 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
     loc0 = locate(t, v_orig, y, baseline.prediction, sigma, n_train, ctx.period_s)
     say(f'baseline: %e_r train {baseline.er_train_percent:.4g}, held-out '
         f'{baseline.er_holdout_percent:.4g} (noise floor {floor_h:.3g})')
+    cut = (start_cut(rec, v, spec, settings, baseline.er_train_percent, floor_t)
+           if settings.start_state else None)
+    if cut is not None:     # a start inside the play: the record from its first reversal
+        say(f'the record started inside the play: diagnosing it from sample {cut.index} on')
+        d = _diagnose(recording.window(cut.index, recording.n_samples), given_spec,
+                      replace(settings, start_state=False), say)
+        d.notes.insert(0, cut.note)
+        return d
     current, loc, findings, rounds = baseline, loc0, [], []
     blocked = BlockedCV(data)
     rechosen, chain_notes = False, []

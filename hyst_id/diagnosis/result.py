@@ -77,6 +77,11 @@ class DiagnoseSettings:
         (docs/diagnosis.md). Off, a diagnosis still runs such a search where
         blocks were accepted against a baseline near its floor
         (:mod:`hyst_id.diagnosis.challenge`); on, there is no such challenge.
+    start_state : bool
+        When the baseline stays above its floor, try the record from the
+        command's first reversal on, and diagnose that instead when a probe
+        there nears the floor (:mod:`hyst_id.diagnosis.start_cut`: an actuator
+        that starts inside its play). On by default.
     should_stop : callable, optional
         Passed to the baseline's identifications (``identify(should_stop=...)``:
         looked at before each jump of hopping and each generation of an
@@ -96,6 +101,7 @@ class DiagnoseSettings:
     fit_budget: int = 600
     hops: int = 100
     more_starts: bool = False
+    start_state: bool = True
     should_stop: Callable[[], bool] | None = field(default=None, compare=False, repr=False)
 
 

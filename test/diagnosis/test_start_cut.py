@@ -1,0 +1,53 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""Diagnose a clean record whose actuator starts inside its play (the reviewer's case).
+
+The data come from the play operator written apart from the package
+(``test/play_reference.py``: ``y = 2 play(u, 0.8) + 1``, noise 0.01). The
+chain starts on an edge of its loop, so the whole record's baseline stays
+above its floor; before :mod:`hyst_id.diagnosis.start_cut` a 20 s rest inside
+the play was diagnosed ``rate_dependence`` + ``creep`` and a start inside it
+with no rest ``unknown``. Measured on noise seeds 0 and 1 (40 s of sine): the
+whole record's baseline 31.7 x (20 s rest) and 8.2 x (no rest) the floor, the
+probe from the first reversal 0.97-0.99 x (the bound :data:`PROBE_NEAR` is 1.3).
+"""
+
+from __future__ import annotations
+
+from play_reference import rest_then_sine
+
+from hyst_id.diagnosis import diagnose, DiagnoseSettings
+from hyst_id.diagnosis.start_cut import PROBE_NEAR
+
+SETTINGS = DiagnoseSettings(workers=1, hops=20)
+
+
+def test_a_start_inside_the_play_is_cut_and_no_physics_is_claimed():
+    rest_s = 20.0       # (no rest is cut the same way: 8.2 x -> 0.99 x; left out for time)
+    rec = rest_then_sine(0, rest_s, True, sine_s=40.0)
+    d = diagnose(rec, settings=SETTINGS)
+    assert d.verdict == 'none' and not d.findings, (d.verdict, d.notes[:1])
+    note = d.notes[0]
+    assert 'left out of the diagnosis' in note and 'inside its play' in note, note
+    assert d.t_s[0] > rest_s                       # the report is of the record after the cut
+    after = float(note.split('without them ')[1].split(' x')[0])
+    assert after <= PROBE_NEAR
+
+
+def test_an_edge_start_is_diagnosed_whole():
+    rec = rest_then_sine(0, 0.0, False, sine_s=40.0)
+    d = diagnose(rec, settings=SETTINGS)
+    assert d.verdict == 'none' and d.t_s[0] == rec.t_s[0]
+    assert not any('left out' in n for n in d.notes)
