@@ -16,7 +16,7 @@
 
 Adding a mechanism is one module exposing ``MECHANISM`` (an instance of a
 :class:`~hyst_id.diagnosis.mechanisms.base.Mechanism` subclass) and one entry
-in :data:`MODULES` below (see ``docs/diagnosis.md``, "Adding a mechanism").
+in the module tuple of :data:`MECHANISMS` below (see ``docs/diagnosis.md``, "Adding a mechanism").
 """
 
 from __future__ import annotations
