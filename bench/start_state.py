@@ -22,7 +22,11 @@ case and noise seed: the whole record's fit over the noise floor (from the
 warning, when the start was left out) and the fit that identify reports.
 See ``hyst_id/identification/start_state.py``. About two minutes.
 
-Usage: ``python bench/start_state.py [--seeds 0 1 2]``
+With ``--diagnose``: ``diagnose`` instead (``hyst_id/diagnosis/start_cut.py``),
+its verdict, findings, and the whole record's baseline and the probe from the
+first reversal over their floors; about 15 s a record.
+
+Usage: ``python bench/start_state.py [--seeds 0 1 2] [--diagnose]``
 """
 
 from __future__ import annotations
@@ -36,6 +40,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / 'test'))
 sys.path.insert(0, str(ROOT))
 
+from hyst_id.diagnosis import diagnose, DiagnoseSettings  # noqa: E402
 from hyst_id.identification import identify, IdentifySettings  # noqa: E402
 
 from play_reference import rest_then_sine  # noqa: E402, I100
@@ -44,10 +49,14 @@ from play_reference import rest_then_sine  # noqa: E402, I100
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument('--seeds', type=int, nargs='+', default=[0, 1, 2])
+    ap.add_argument('--diagnose', action='store_true', help='diagnose instead of identify')
     args = ap.parse_args()
     settings = IdentifySettings(seeds=(0, 1, 2), workers=1)
     for rest, inside in ((20.0, True), (0.0, True), (20.0, False)):
         for seed in args.seeds:
+            if args.diagnose:
+                _diagnose(rest, inside, seed)
+                continue
             ident = identify(rest_then_sine(seed, rest, inside, sine_s=40.0), settings=settings)
             ratio = ident.er_percent / ident.noise_floor_percent
             left = next((w for w in ident.warnings if 'left out of the fit' in w), '')
@@ -57,6 +66,17 @@ def main() -> None:
                   f'{whole.group(1) if whole else f"{ratio:.2f}"} x the floor, reported '
                   f'{ratio:.3f} x' + (f' (the first {left.split(" s (")[0][10:]} s left out)'
                                       if left else ' (fitted whole)'), flush=True)
+
+
+def _diagnose(rest: float, inside: bool, seed: int) -> None:
+    d = diagnose(rest_then_sine(seed, rest, inside, sine_s=40.0),
+                 settings=DiagnoseSettings(workers=1))
+    left = next((n for n in d.notes if 'left out of the diagnosis' in n), '')
+    ratios = re.search(r'with them the fit was ([0-9.]+) x .* without them ([0-9.]+) x', left)
+    print(f'rest {rest:g} s, {"inside the play" if inside else "on its edge"}, noise seed '
+          f'{seed}: verdict {d.verdict} {[f.mechanism for f in d.findings]}, '
+          + (f'cut at {d.t_s[0]:.2f} s: whole-record baseline {ratios.group(1)} x, probe '
+             f'{ratios.group(2)} x the floor' if ratios else 'diagnosed whole'), flush=True)
 
 
 if __name__ == '__main__':

@@ -80,6 +80,10 @@ def add_settings_arguments(parser: argparse.ArgumentParser, identify: bool = Tru
                    help="search domains: derived from the data (auto), the paper's "
                    'preset (paper), or a YAML mapping name: [low, high] that overrides '
                    'the derived ones')
+    g.add_argument('--whole-record', action='store_true',
+                   help='fit (diagnose) the whole record even when it seems to start inside '
+                   "the play; by default a poor fit is tried again from the command's first "
+                   'reversal and the part before it is left out when that fits clearly better')
     if not identify:
         return
     g.add_argument('--c', type=float, default=0.007, help='search-space contraction rate')
@@ -177,7 +181,8 @@ def make_settings(args: argparse.Namespace) -> IdentifySettings:
         generations=args.generations, c=args.c, xi=args.xi, workers=args.workers,
         refine=not args.gaass_only, restarts=args.restarts, er_bound_percent=args.er_bound,
         global_evals=args.global_evals, global_runs=args.global_runs, hops=args.hops,
-        search_samples=args.search_samples, more_starts=args.more_starts)
+        search_samples=args.search_samples, more_starts=args.more_starts,
+        start_state=not args.whole_record)
 
 
 def make_spec(args: argparse.Namespace, rec: Recording, family: str | None = None) -> ChainSpec:

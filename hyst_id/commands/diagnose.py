@@ -93,7 +93,7 @@ def _settings(args: argparse.Namespace):
         seeds=tuple(range(args.seed_offset, args.seed_offset + args.seeds)),
         generations=args.generations, pop_size=args.pop_size, workers=args.workers,
         mechanisms=mechs, max_mechanisms=args.max_mechanisms, hops=args.hops,
-        more_starts=args.more_starts)
+        more_starts=args.more_starts, start_state=not args.whole_record)
 
 
 def _write_params(diag, path: str) -> None:

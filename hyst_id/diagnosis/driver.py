@@ -239,6 +239,9 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
         d = _diagnose(recording.window(cut.index, recording.n_samples), given_spec,
                       replace(settings, start_state=False), say)
         d.notes.insert(0, cut.note)
+        d.extra['start_cut'] = {'samples_left_out': cut.index, 'first_t_s': float(t[cut.index]),
+                                'baseline_over_floor': cut.before_ratio,
+                                'probe_over_floor': cut.probe_ratio}
         return d
     current, loc, findings, rounds = baseline, loc0, [], []
     blocked = BlockedCV(data)

@@ -328,3 +328,15 @@ def test_diagnose_names_the_training_part_when_only_it_lacks_reversals(tmp_path,
     err = capsys.readouterr().err.strip().splitlines()[-1]
     assert str(csv) in err and 'its training part (the first 70% of its duration' in err, err
     assert 'command reverses 1 time(s)' in err
+
+
+def test_whole_record_turns_the_start_state_retry_off_in_identify_and_diagnose(tmp_path):
+    from hyst_id.cli import build_parser
+    from hyst_id.commands.common import make_settings
+    from hyst_id.commands.diagnose import _settings
+    parser = build_parser()
+    for flags, expected in (([], True), (['--whole-record'], False)):
+        args = parser.parse_args(['identify', 'run.csv'] + flags)
+        assert make_settings(args).start_state is expected
+        args = parser.parse_args(['diagnose', 'run.csv'] + flags)
+        assert _settings(args).start_state is expected

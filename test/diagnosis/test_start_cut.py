@@ -44,10 +44,13 @@ def test_a_start_inside_the_play_is_cut_and_no_physics_is_claimed():
     assert d.t_s[0] > rest_s                       # the report is of the record after the cut
     after = float(note.split('without them ')[1].split(' x')[0])
     assert after <= PROBE_NEAR
+    cut = d.to_dict()['start_cut']                  # and in --json
+    assert cut['first_t_s'] == d.t_s[0] and cut['probe_over_floor'] <= PROBE_NEAR
+    assert cut['baseline_over_floor'] > 1.5 * cut['probe_over_floor']
 
 
 def test_an_edge_start_is_diagnosed_whole():
     rec = rest_then_sine(0, 0.0, False, sine_s=40.0)
     d = diagnose(rec, settings=SETTINGS)
     assert d.verdict == 'none' and d.t_s[0] == rec.t_s[0]
-    assert not any('left out' in n for n in d.notes)
+    assert not any('left out' in n for n in d.notes) and 'start_cut' not in d.to_dict()
