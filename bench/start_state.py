@@ -24,9 +24,10 @@ See ``hyst_id/identification/start_state.py``. About two minutes.
 
 With ``--diagnose``: ``diagnose`` instead (``hyst_id/diagnosis/start_cut.py``),
 its verdict, findings, and the whole record's baseline and the probe from the
-first reversal over their floors; about 15 s a record.
+first reversal over their floors; about 7 minutes for the nine records. With
+``--whole-record`` too, the diagnosis without the cut (what it was before).
 
-Usage: ``python bench/start_state.py [--seeds 0 1 2] [--diagnose]``
+Usage: ``python bench/start_state.py [--seeds 0 1 2] [--diagnose [--whole-record]]``
 """
 
 from __future__ import annotations
@@ -50,12 +51,14 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument('--seeds', type=int, nargs='+', default=[0, 1, 2])
     ap.add_argument('--diagnose', action='store_true', help='diagnose instead of identify')
+    ap.add_argument('--whole-record', action='store_true',
+                    help='with --diagnose: no start cut (DiagnoseSettings.start_state off)')
     args = ap.parse_args()
     settings = IdentifySettings(seeds=(0, 1, 2), workers=1)
     for rest, inside in ((20.0, True), (0.0, True), (20.0, False)):
         for seed in args.seeds:
             if args.diagnose:
-                _diagnose(rest, inside, seed)
+                _diagnose(rest, inside, seed, not args.whole_record)
                 continue
             ident = identify(rest_then_sine(seed, rest, inside, sine_s=40.0), settings=settings)
             ratio = ident.er_percent / ident.noise_floor_percent
@@ -68,9 +71,9 @@ def main() -> None:
                                       if left else ' (fitted whole)'), flush=True)
 
 
-def _diagnose(rest: float, inside: bool, seed: int) -> None:
+def _diagnose(rest: float, inside: bool, seed: int, cut: bool) -> None:
     d = diagnose(rest_then_sine(seed, rest, inside, sine_s=40.0),
-                 settings=DiagnoseSettings(workers=1))
+                 settings=DiagnoseSettings(workers=1, start_state=cut))
     left = next((n for n in d.notes if 'left out of the diagnosis' in n), '')
     ratios = re.search(r'with them the fit was ([0-9.]+) x .* without them ([0-9.]+) x', left)
     print(f'rest {rest:g} s, {"inside the play" if inside else "on its edge"}, noise seed '
