@@ -38,8 +38,8 @@ from hyst_id.identification.chains import ChainSpec
 from hyst_id.identification.starts import data_starts, SPLITS
 from hyst_id.io.recording import Recording, ROUNDOFF_PROBE_ENV
 
-__all__ = ['baseline_starts', 'forget_quick', 'quick_memo', 'quick_starts', 'remember',
-           'structured_starts', 'whole_record_er']
+__all__ = ['baseline_starts', 'forget_quick', 'identify_base', 'quick_memo', 'quick_starts',
+           'remember', 'structured_starts', 'whole_record_er']
 
 #: Most quick searches kept (:func:`quick_starts`); the oldest go first.
 QUICK_KEPT = 8
@@ -57,7 +57,7 @@ def structured_starts(spec: ChainSpec, t_s: np.ndarray, v: np.ndarray, y: np.nda
                        splits=splits, per_split=1)
 
 
-def _identify_base(settings) -> dict:
+def identify_base(settings) -> dict:
     """The identify settings of a diagnosis baseline, from its ``DiagnoseSettings``."""
     return {'pop_size': settings.pop_size, 'maxiter': settings.generations,
             'seeds': tuple(settings.seeds), 'workers': settings.workers, 'refine': True,
@@ -89,7 +89,7 @@ def baseline_starts(rec_train: Recording, spec: ChainSpec, settings, *, thorough
     (one run) to the quick search (the re-identification of a chain with its
     accepted blocks undone, :mod:`hyst_id.diagnosis.refit`).
     """
-    base = _identify_base(settings)
+    base = identify_base(settings)
     runs = []
     for conventions in (('given', 'auto') if thorough else ('given',)):
         use_global = thorough if global_phase is None else global_phase
@@ -120,7 +120,7 @@ def _quick_key(rec_train: Recording, spec: ChainSpec, settings) -> str:
     h = hashlib.sha1()
     for a in (rec_train.t_s, rec_train.command, rec_train.measurement, spec.bounds):
         h.update(np.ascontiguousarray(a, dtype=float).tobytes())
-    search = {k: v for k, v in _identify_base(settings).items() if k != 'workers'}
+    search = {k: v for k, v in identify_base(settings).items() if k != 'workers'}
     h.update(repr((rec_train.channel, spec.channel, spec.family.id, spec.initial, spec.hold,
                    spec.calibration, spec.domain_source, sorted(search.items()),
                    os.environ.get(ROUNDOFF_PROBE_ENV, '').strip())).encode())
@@ -181,7 +181,7 @@ def whole_record_er(rec: Recording, spec: ChainSpec, settings) -> float:
     training's did not, along the loop), not physics. Identify's global
     phase as in the baseline (one run per convention, hopping).
     """
-    base = _identify_base(settings)
+    base = identify_base(settings)
     return float(identify(rec, spec=spec, settings=IdentifySettings(
         **base, global_runs=4, more_starts=settings.more_starts),
         should_stop=settings.should_stop).er_percent)

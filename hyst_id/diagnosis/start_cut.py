@@ -40,6 +40,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from hyst_id.diagnosis.baseline import identify_base
 from hyst_id.diagnosis.result import DiagnoseSettings
 from hyst_id.identification import identify, IdentifySettings
 from hyst_id.identification.chains import ChainSpec
@@ -95,11 +96,9 @@ def start_cut(rec: Recording, command_model: np.ndarray, spec: ChainSpec,
         return None
     part = Recording(rest_t[:n_train], command_model[k:k + n_train],
                      rec.measurement[k:k + n_train], rec.channel, source=rec.source)
-    probe = identify(part, spec=spec, settings=IdentifySettings(
-        pop_size=settings.pop_size, maxiter=settings.generations,
-        seeds=tuple(settings.seeds)[:2], workers=settings.workers, refine=True, refine_top=2,
-        restarts=1, refine_max_nfev=1500, hops=0, global_runs=0, start_state=False),
-        should_stop=settings.should_stop)
+    probe = identify(part, spec=spec, settings=IdentifySettings(**{
+        **identify_base(settings), 'seeds': tuple(settings.seeds)[:2], 'hops': 0,
+        'global_runs': 0}), should_stop=settings.should_stop)
     if not probe.noise_floor_percent > 0:
         return None
     before = er_train_percent / floor_train_percent

@@ -377,12 +377,12 @@ def test_cli_hops_reach_the_baseline():
     import argparse
 
     from hyst_id.commands import diagnose as command
-    from hyst_id.diagnosis.baseline import _identify_base
+    from hyst_id.diagnosis.baseline import identify_base
     parser = argparse.ArgumentParser()
     command.add_arguments(parser)
     for argv, hops in (([], 100), (['--hops', '0'], 0), (['--hops', '7'], 7)):
         settings = command._settings(parser.parse_args(['r.csv'] + argv))
-        assert settings.hops == hops and _identify_base(settings)['hops'] == hops
+        assert settings.hops == hops and identify_base(settings)['hops'] == hops
     assert DiagnoseSettings().hops == 100
 
 

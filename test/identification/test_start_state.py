@@ -34,7 +34,7 @@ from play_reference import rest_then_sine
 import pytest
 
 from hyst_id.diagnosis import DiagnoseSettings
-from hyst_id.diagnosis.baseline import _identify_base
+from hyst_id.diagnosis.baseline import identify_base
 from hyst_id.identification import identify, IdentifySettings
 from hyst_id.identification.start_state import refit_start
 
@@ -66,7 +66,7 @@ def test_the_retry_is_off_where_the_whole_record_is_judged():
                      settings=replace(SETTINGS, start_state=False))
     assert ident.er_percent > 5 * ident.noise_floor_percent
     assert not any('left out of the fit' in w for w in ident.warnings), ident.warnings
-    assert not _identify_base(DiagnoseSettings())['start_state']
+    assert not identify_base(DiagnoseSettings())['start_state']
 
 
 def test_a_start_on_the_edge_of_the_play_is_fitted_whole():
