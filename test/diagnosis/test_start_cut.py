@@ -54,3 +54,19 @@ def test_an_edge_start_is_diagnosed_whole():
     d = diagnose(rec, settings=SETTINGS)
     assert d.verdict == 'none' and d.t_s[0] == rec.t_s[0]
     assert not any('left out' in n for n in d.notes) and 'start_cut' not in d.to_dict()
+
+
+def test_start_state_off_never_tries_the_cut(monkeypatch):
+    """``DiagnoseSettings.start_state`` (``--whole-record``) decides whether the cut is tried.
+
+    Checked where it is cheap: the edge start's baseline is at its floor, so
+    :func:`start_cut` answers None at once when asked; here it only records the asking.
+    """
+    import hyst_id.diagnosis.driver as driver
+    asked = []
+    monkeypatch.setattr(driver, 'start_cut', lambda *a, **k: asked.append(a) or None)
+    rec = rest_then_sine(0, 0.0, False, sine_s=40.0)
+    diagnose(rec, settings=DiagnoseSettings(workers=1, hops=20, start_state=False))
+    assert asked == []
+    diagnose(rec, settings=SETTINGS)
+    assert len(asked) == 1
