@@ -110,7 +110,7 @@ def add_settings_arguments(parser: argparse.ArgumentParser, identify: bool = Tru
 
 def load_recording(args: argparse.Namespace) -> Recording:
     """Read and validate the recording named on the command line."""
-    from hyst_id.io.csv_reader import TIME_UNIT_NOTE
+    from hyst_id.io.csv_reader import time_unit_notes
     from hyst_id.io.readers import read_recording
     from hyst_id.io.topics import load_topic_file
 
@@ -121,9 +121,8 @@ def load_recording(args: argparse.Namespace) -> Recording:
               'GAASS settings and domains as flags)', file=sys.stderr)
     rec = read_recording(args.recording, args.channel, topics=topics,
                          columns=parse_columns(args.columns), time_scale=args.time_scale)
-    for note in rec.notes:
-        if note.startswith(TIME_UNIT_NOTE):
-            print(f'note: {note[len(TIME_UNIT_NOTE):].strip()}', file=sys.stderr)
+    for note in time_unit_notes(rec.notes):
+        print(f'note: {note}', file=sys.stderr)
     return rec
 
 

@@ -28,6 +28,7 @@ from hyst_id.errors import ConfigError
 from hyst_id.fleet import find_recordings, FleetOptions, loop_trends, run_fleet, write_table
 from hyst_id.fleet.table import fleet_rows
 from hyst_id.identification.config import make_settings
+from hyst_id.io.csv_reader import time_unit_notes
 from hyst_id.io.outputs import make_output_folder
 from hyst_id.io.recording import CHANNELS
 
@@ -128,6 +129,9 @@ def run(args: argparse.Namespace) -> int:
     for r in bad:     # a reader's error names the file already
         print(f'  failed: {r["recording"]}: '
               f'{str(r["error"]).removeprefix(str(r["recording"]) + ": ")}')
+    for d in docs:    # a CSV time column read as seconds that looks like another unit
+        for note in time_unit_notes(d.get('notes') or []):
+            print(f'  note: {Path(d["recording"]).name}: {note}')
     for t in trends:
         if t['flagged']:
             print(f'  trend: valve {t["valve"]}: {t["metric"]} {t["first"]:.4g} -> '

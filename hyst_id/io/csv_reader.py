@@ -30,7 +30,8 @@ import numpy as np
 from hyst_id.errors import ConfigError, MissingTopicError, RecordingError
 from hyst_id.io.recording import Recording
 
-__all__ = ['CSV_SUFFIXES', 'DEFAULT_COLUMNS', 'TIME_UNIT_NOTE', 'read_csv', 'time_unit_hint']
+__all__ = ['CSV_SUFFIXES', 'DEFAULT_COLUMNS', 'TIME_UNIT_NOTE', 'read_csv', 'time_unit_hint',
+           'time_unit_notes']
 
 #: File suffixes read as delimited text.
 CSV_SUFFIXES = ('.csv', '.txt', '.tsv')
@@ -45,6 +46,11 @@ _TIME_UNITS = (('ms|msec|millis|milliseconds?', 1e-3), ('us|usec|µs|micros|micr
 _COUNTER_WORDS = frozenset({'index', 'idx', 'sample', 'samples', 'n', 'k', 'step'})
 #: A median sample interval from which seconds are doubtful for an actuator record.
 _SLOW_INTERVAL_S = 0.5
+
+
+def time_unit_notes(notes: Sequence[str]) -> list[str]:
+    """The :func:`time_unit_hint` notes among a recording's ``notes``, without their tag."""
+    return [n[len(TIME_UNIT_NOTE):].strip() for n in notes if str(n).startswith(TIME_UNIT_NOTE)]
 
 
 def time_unit_hint(label: str, t: np.ndarray) -> str | None:

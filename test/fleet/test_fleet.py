@@ -145,6 +145,13 @@ def test_cli_fleet_reads_headerless_csv_columns_and_refuses_bad_options(tmp_path
         assert cli_main(args + extra) == 2, extra
         err = capsys.readouterr().err
         assert needle in err and 'internal error' not in err, err
+    # the ms column read as seconds: the fleet says so, as identify does
+    fresh = ['fleet', str(folder), '--out', str(tmp_path / 'out2')] + args[4:]
+    assert cli_main(fresh + ['--columns', '0,2,1']) == 0
+    said = capsys.readouterr().out
+    assert "note: run.csv: the time column '#0' is read as seconds" in said, said
+    assert cli_main(args + ['--columns', '0,2,1', '--time-scale', '0.001']) == 0
+    assert 'time column' not in capsys.readouterr().out
 
 
 @pytest.mark.slow
