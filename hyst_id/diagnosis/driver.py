@@ -220,6 +220,7 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
                   'its duration; train_fraction sets it)')
     ctx = Context(channel=rec.channel, t_s=t, n_train=n_train, command_scale=scale,
                   command_unit=rec.command_unit, measurement_unit=rec.measurement_unit,
+                  measurement_name=rec.measurement_name,
                   extra={'period_s': period_s(t[:n_train], v[:n_train])})
     sigma = noise_std(y)
     data = Data(t_s=t, v=v, y=y, n_train=n_train, noise_std=sigma,
@@ -366,6 +367,7 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
                      noise_floor_percent=floor_h, noise_floor_train_percent=floor_t,
                      rounds=rounds, baseline_params=_chain_dict(rec.channel, baseline.p),
                      measurement_unit=rec.measurement_unit, command_unit=rec.command_unit,
+                     measurement_name=rec.measurement_name, command_name=rec.command_name,
                      notes=notes, extra={**extra, 'command_scale': list(scale),
                                          'hold': current.model.hold
                                          if current.model.dynamic else '',

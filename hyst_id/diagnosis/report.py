@@ -187,8 +187,9 @@ def format_diagnosis(d: Any) -> str:
     nt = d.n_train
     unit = d.measurement_unit
     mode = ' (simulator vs recording)' if d.mode == 'sim' else ''
-    lines = [f'diagnosis of {d.source or "recording"}: channel {d.channel}, {t.size} samples '
-             f'over {t[-1] - t[0]:.1f} s{mode}',
+    named = f' (measurement {d.measurement_name})' if d.measurement_name else ''
+    lines = [f'diagnosis of {d.source or "recording"}: channel {d.channel}{named}, '
+             f'{t.size} samples over {t[-1] - t[0]:.1f} s{mode}',
              f'split: trained on {t[0]:.1f}-{t[nt - 1]:.1f} s ({nt} samples), held out '
              f'{t[nt]:.1f}-{t[-1]:.1f} s ({t.size - nt} samples)']
     what = 'the simulator as given' if d.mode == 'sim' else "the paper's chain"
@@ -343,7 +344,7 @@ def plot_diagnosis(d: Any, path: str | Path, *, dpi: int = 110) -> Path:
     if d.findings:
         a.plot(t, fin, lw=1, color='tab:blue', label=label)
     a.axvspan(t[nt], t[-1], color='0.9', zorder=0, label='held out')
-    a.set_ylabel(f'{d.channel} [{d.measurement_unit or "units"}]')
+    a.set_ylabel(f'{d.quantity} [{d.measurement_unit or "units"}]')
     a.legend(loc='best', fontsize=8)
     a.set_title(f'verdict: {d.verdict}')
     a = ax[1, 0]
@@ -371,7 +372,7 @@ def plot_diagnosis(d: Any, path: str | Path, *, dpi: int = 110) -> Path:
     a.plot(d.command[ho], base[ho], lw=0.7, color='tab:red', label=what)
     if d.findings:
         a.plot(d.command[ho], fin[ho], lw=0.7, color='tab:blue', label='augmented')
-    a.set_xlabel(f'command [{d.command_unit or "units"}]')
+    a.set_xlabel(f'{d.command_name or "command"} [{d.command_unit or "units"}]')
     a.legend(loc='best', fontsize=7)
     a.set_title('held-out loop')
     a = ax[1, 1]

@@ -173,6 +173,14 @@ class Diagnosis:
     extra: dict = field(default_factory=dict)
     #: What a model could still gain (:class:`~hyst_id.diagnosis.empirical.EmpiricalBlock`).
     empirical: Any = None
+    #: What the file calls the signals (a CSV header's names); empty when unknown.
+    measurement_name: str = ''
+    command_name: str = ''
+
+    @property
+    def quantity(self) -> str:
+        """The measured quantity for words and axes: the file's name for it, else the channel."""
+        return self.measurement_name or self.channel
 
     @property
     def train_fraction(self) -> float:
@@ -195,6 +203,7 @@ class Diagnosis:
             'noise_floor_percent': self.noise_floor_percent,
             'noise_floor_train_percent': self.noise_floor_train_percent,
             'noise_std': self.noise_std, 'measurement_unit': self.measurement_unit,
+            'measurement_name': self.measurement_name, 'command_name': self.command_name,
             'findings': [f.to_dict() for f in self.findings],
             'final': {'mechanisms': list(self.final.ids),
                       'er_train_percent': self.final.er_train_percent,

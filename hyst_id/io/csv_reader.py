@@ -197,4 +197,6 @@ def read_csv(path: str | Path, channel: str, *,
     return Recording(t_s=data[:, 0] * float(time_scale), command=data[:, 1],
                      measurement=data[:, 2], channel=channel, command_unit=command_unit,
                      measurement_unit=measurement_unit, source=str(path),
-                     notes=(note,) + ((hint,) if hint else ()))
+                     notes=(note,) + ((hint,) if hint else ()),
+                     command_name=labels[1] if names else '',
+                     measurement_name=labels[2] if names else '')

@@ -77,6 +77,11 @@ class Recording:
         Free-text units, for reports only.
     source : str
         Where the data came from (path, topic names), for reports only.
+    notes : tuple of str
+        What the reader noticed (column mapping, a time-unit hint).
+    command_name, measurement_name : str
+        What the file calls the two signals (a CSV header's column names),
+        for reports only; empty when unknown.
     """
 
     t_s: np.ndarray
@@ -87,6 +92,18 @@ class Recording:
     measurement_unit: str = ''
     source: str = ''
     notes: tuple = field(default=())
+    command_name: str = ''
+    measurement_name: str = ''
+
+    @property
+    def quantity(self) -> str:
+        """What the measurement is, for words and axes: its name in the file, else the channel.
+
+        The channel names the chain's structure (``position``: no sensor
+        dynamics), which for a user's file need not be what was measured
+        (a force, a flux density).
+        """
+        return self.measurement_name or self.channel
 
     @property
     def n_samples(self) -> int:

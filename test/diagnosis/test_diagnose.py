@@ -270,6 +270,32 @@ def test_report_and_figure(delay_diagnosis, clean_diagnosis, tmp_path):
     assert 5_000 < small.stat().st_size < path.stat().st_size
 
 
+def test_words_and_axes_name_what_the_file_measured(delay_diagnosis, tmp_path, monkeypatch):
+    """A force recorded on the position chain is called a force, not a position."""
+    import matplotlib.axes
+    from dataclasses import replace
+    from hyst_id.diagnosis.mechanisms.base import Quantity
+    d = replace(delay_diagnosis, measurement_name='force_N', command_name='stroke_mm')
+    assert d.report().splitlines()[0].endswith(
+        f'channel position (measurement force_N), {d.t_s.size} samples over '
+        f'{d.t_s[-1] - d.t_s[0]:.1f} s')
+    assert d.to_dict()['measurement_name'] == 'force_N'
+    labels = []
+    for name in ('set_xlabel', 'set_ylabel'):
+        plain = getattr(matplotlib.axes.Axes, name)
+
+        def kept(ax, text, *args, _plain=plain, **kwargs):
+            labels.append(text)
+            return _plain(ax, text, *args, **kwargs)
+        monkeypatch.setattr(matplotlib.axes.Axes, name, kept)
+    plot_diagnosis(d, tmp_path / 'fig.png', dpi=50)
+    assert 'force_N [mA-eq]' in labels and 'stroke_mm [mA]' in labels, labels
+    ctx = Context('position', d.t_s, d.n_train, measurement_name='force_N')
+    words = MECHANISMS['sensor_lag'].explain({'tau_lag_s': Quantity(0.1, 's')}, None, ctx)
+    assert words.startswith('The measured force_N lags'), words
+    assert Context('position', d.t_s, d.n_train).quantity == 'position'
+
+
 def test_locate_white_noise_is_white_and_a_delay_is_not():
     rng = np.random.default_rng(1)
     t = np.arange(0.0, 100.0, 0.05)

@@ -582,3 +582,17 @@ def test_topic_config_errors(tmp_path: Path) -> None:
     _raises(ConfigError, TopicConfig.for_channel, 'torque')
     _raises(ConfigError, TopicConfig.for_channel, 'flow', {'flow_topic': '/hyst_id/command'})
     _raises(ConfigError, TopicConfig.for_channel, 'flow', {'stamp_source': 'wall'})
+
+
+def test_a_csv_header_names_the_signals_for_words_and_axes(tmp_path: Path) -> None:
+    """The channel names the chain's structure; what was measured is the file's own name."""
+    body = ''.join(f'{0.01 * i:.3f},{np.sin(i / 9):.6f},{np.cos(i / 9):.6f}\n'
+                   for i in range(200))
+    named = read_recording(_write(tmp_path / 'named.csv', 't,stroke_mm,force_N\n' + body),
+                           'position', columns=('t', 'stroke_mm', 'force_N'))
+    assert (named.command_name, named.measurement_name) == ('stroke_mm', 'force_N')
+    assert named.quantity == 'force_N' and named.channel == 'position'
+    assert named.window(10, 150).quantity == 'force_N'      # a part keeps the names
+    bare = read_recording(_write(tmp_path / 'bare.csv', body), 'pressure', columns=(0, 1, 2))
+    assert (bare.command_name, bare.measurement_name) == ('', '')
+    assert bare.quantity == 'pressure'                      # unnamed: the channel

@@ -83,6 +83,8 @@ class Context:
         ``(a, b)`` with ``command_original = a * command_model + b``.
     command_unit, measurement_unit : str
         Units for the words.
+    measurement_name : str
+        What the file calls the measurement (empty: unknown); see :attr:`quantity`.
     extra : dict
         Anything else (e.g. the baseline travel) a mechanism wants to keep.
     """
@@ -94,6 +96,12 @@ class Context:
     command_unit: str = ''
     measurement_unit: str = ''
     extra: dict = field(default_factory=dict)
+    measurement_name: str = ''
+
+    @property
+    def quantity(self) -> str:
+        """The measured quantity for the words: the file's name for it, else the channel."""
+        return self.measurement_name or self.channel
 
     @property
     def dt_s(self) -> float:

@@ -245,7 +245,7 @@ class Friction(Mechanism):
         else:
             sense = ("but the band runs the hysteresis's own way round on a reading that "
                      'changes over the travel: it may be backlash rather than friction')
-        return (f'The measured {ctx.channel} carries a sliding-friction force of '
+        return (f'The measured {ctx.quantity} carries a sliding-friction force of '
                 f'±{f.value:.3g} {f.unit}: higher while the command {up} than while it '
                 f'{down}, turning round within {pre.value:.3g} {pre.unit} of travel after '
                 f'each reversal ({sense}). Friction of a seal, guide or stem in the force '

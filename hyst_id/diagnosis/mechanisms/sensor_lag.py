@@ -86,7 +86,7 @@ class SensorLag(Mechanism):
         if 'tau_s' in values:
             extra = (f' (in series with the modelled {values["tau_s"].value:.3g} s; the two '
                      'time constants are interchangeable)')
-        return (f'The measured {ctx.channel} lags the actuator through an extra first-order '
+        return (f'The measured {ctx.quantity} lags the actuator through an extra first-order '
                 f'lag of {tau:.3g} s{extra}: transmitter filtering, tubing to the transducer or '
                 'the thermal mass of the sensor. Feedback on this signal sees the actuator late: '
                 'include the lag in the model or observer, or use a faster sensor.')

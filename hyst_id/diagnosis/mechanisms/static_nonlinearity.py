@@ -99,7 +99,7 @@ class StaticNonlinearity(Mechanism):
         dev = values['max_deviation']
         shape = ('rises faster towards the top of the travel' if abs(r) > 1 else
                  'flattens towards the top of the travel')
-        return (f'The measured {ctx.channel} is not proportional to the actuator position: '
+        return (f'The measured {ctx.quantity} is not proportional to the actuator position: '
                 f'its sensitivity {shape} (top/bottom ratio {r:.2f}; up to {abs(dev.value):.3g} '
                 f'{dev.unit} = {values["max_deviation_percent"].value:.1f} % of the span away '
                 'from a straight line). A nonlinear valve characteristic (e.g. '
