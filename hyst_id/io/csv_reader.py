@@ -80,12 +80,23 @@ def time_unit_hint(label: str, t: np.ndarray) -> str | None:
     return None
 
 
-def _is_number(cell: str) -> bool:
+def _number(cell: str, decimal_comma: bool) -> float | None:
+    """The cell's value, or None; ``1,5`` is 1.5 when cells are not comma-separated."""
     try:
-        float(cell)
+        return float(cell)
     except ValueError:
-        return False
-    return True
+        pass
+    if decimal_comma and cell.count(',') == 1 and '.' not in cell:
+        try:
+            return float(cell.replace(',', '.'))
+        except ValueError:
+            return None
+    return None
+
+
+def _unit_of(cell: str) -> str:
+    """A unit row's cell without its brackets (``[mm]``, ``(V)``)."""
+    return cell.strip().strip('[]()').strip()
 
 
 def read_csv(path: str | Path, channel: str, *,
@@ -98,7 +109,11 @@ def read_csv(path: str | Path, channel: str, *,
     ----------
     path : str or pathlib.Path
         The file. Blank lines and lines starting with ``#`` are skipped; the
-        first other line is a header if any of its cells is not a number.
+        first other line is a header if any of its cells is not a number. A
+        row under the header with no number in it is a unit row (``[s];[V];[um]``):
+        its units fill ``command_unit`` / ``measurement_unit`` when not given,
+        and the time column's is read by :func:`time_unit_hint`. Where cells are
+        not comma-separated a decimal comma is read (``0,25`` is 0.25).
     channel : str
         Measured channel stored in the recording.
     columns : sequence of str or int
@@ -109,8 +124,8 @@ def read_csv(path: str | Path, channel: str, *,
         reads seconds and adds a :func:`time_unit_hint` note when the
         column looks like another unit.
     delimiter : str, optional
-        Cell separator; default comma if the first line has one, else
-        semicolon if it has one, else runs of whitespace.
+        Cell separator; default a tab if the first line has one, else a
+        semicolon, else a comma, else runs of whitespace.
     command_unit, measurement_unit : str
         Units for reports.
 
@@ -150,14 +165,21 @@ def read_csv(path: str | Path, channel: str, *,
         raise RecordingError(f'empty file: {path}')
     sep = delimiter
     if sep is None:
-        sep = ',' if ',' in lines[0][1] else ';' if ';' in lines[0][1] else None
+        first_line = lines[0][1]     # a tab or ';' first: their cells may hold decimal commas
+        sep = next((c for c in ('\t', ';', ',') if c in first_line), None)
 
     def split(line: str) -> list[str]:
         return [c.strip().strip('"\'') for c in (line.split(sep) if sep else line.split())]
 
+    comma = sep != ','      # a decimal comma (``0,25``) where cells are not comma-separated
     first = split(lines[0][1])
-    names = first if not all(_is_number(c) for c in first) else None
+    names = first if not all(_number(c, comma) is not None for c in first) else None
     rows = lines[1:] if names is not None else lines
+    unit_row = None
+    if names is not None and rows and len(split(rows[0][1])) == len(first) and all(
+            _number(c, comma) is None for c in split(rows[0][1]) if c):
+        unit_row = [_unit_of(c) for c in split(rows[0][1])]   # ``[s];[V];[um]`` under a header
+        rows = rows[1:]
     if not rows:
         raise RecordingError(f'no data rows in {path}: only a header')
     ncols = len(first)
@@ -186,14 +208,19 @@ def read_csv(path: str | Path, channel: str, *,
             raise RecordingError(f'ragged rows in {path}: line {lineno} has {len(cells)} '
                                  f'fields, expected {ncols}')
         for j, i in enumerate(index):
-            try:
-                data[r, j] = float(cells[i])
-            except ValueError:
+            value = _number(cells[i], comma)
+            if value is None:
                 raise RecordingError(f'non-numeric value {cells[i]!r} in column {labels[j]} '
-                                     f'at line {lineno} of {path}') from None
+                                     f'at line {lineno} of {path}')
+            data[r, j] = value
     note = (f'columns: t_s = {labels[0]} x {time_scale:g}, command = {labels[1]}, '
             f'measurement = {labels[2]}')
-    hint = None if given_scale else time_unit_hint(labels[0], data[:, 0])
+    units = [unit_row[i] for i in index] if unit_row else ['', '', '']
+    if unit_row:
+        note += f'; units from the row under the header: {", ".join(units)}'
+        command_unit, measurement_unit = command_unit or units[1], measurement_unit or units[2]
+    time_label = f'{labels[0]} [{units[0]}]' if units[0] else labels[0]
+    hint = None if given_scale else time_unit_hint(time_label, data[:, 0])
     return Recording(t_s=data[:, 0] * float(time_scale), command=data[:, 1],
                      measurement=data[:, 2], channel=channel, command_unit=command_unit,
                      measurement_unit=measurement_unit, source=str(path),

@@ -596,3 +596,28 @@ def test_a_csv_header_names_the_signals_for_words_and_axes(tmp_path: Path) -> No
     bare = read_recording(_write(tmp_path / 'bare.csv', body), 'pressure', columns=(0, 1, 2))
     assert (bare.command_name, bare.measurement_name) == ('', '')
     assert bare.quantity == 'pressure'                      # unnamed: the channel
+
+
+def test_a_decimal_comma_and_a_unit_row_are_read(tmp_path: Path) -> None:
+    """``0,25`` where cells are split by ``;`` or tabs, and a ``[s];[V];[um]`` row."""
+    t, v, y = np.arange(200) * 0.05, np.sin(np.arange(200) / 9), np.cos(np.arange(200) / 9)
+    rows = [(f'{a:.4f}', f'{b:.6f}', f'{c:.6f}') for a, b, c in zip(t, v, y)]
+    comma = _write(tmp_path / 'de.csv', 't;command;measurement\n' + ''.join(
+        ';'.join(cell.replace('.', ',') for cell in row) + '\n' for row in rows))
+    got = read_recording(comma, 'position')
+    np.testing.assert_allclose(got.t_s, t, atol=1e-9)
+    np.testing.assert_allclose(got.measurement, y, atol=1e-6)
+    headerless = _write(tmp_path / 'de_bare.tsv', ''.join(
+        '\t'.join(cell.replace('.', ',') for cell in row) + '\n' for row in rows))
+    assert read_recording(headerless, 'position', columns=(0, 1, 2)).n_samples == 200
+    with pytest.raises(RecordingError, match="non-numeric value '1,234,5'"):
+        read_csv(_write(tmp_path / 'bad.csv', 't;command;measurement\n0;1;2\n0,1;1,234,5;2\n'),
+                 'position')
+    units = _write(tmp_path / 'units.csv', 't;command;measurement\n[ms];[V];(um)\n' + ''.join(
+        f'{1000 * float(a):.1f};{b};{c}\n' for a, b, c in rows))
+    got = read_recording(units, 'position')
+    assert (got.command_unit, got.measurement_unit) == ('V', 'um')
+    assert _unit_notes(got) and '--time-scale 0.001' in _unit_notes(got)[0]   # ms named below
+    given = read_csv(units, 'position', time_scale=1e-3, measurement_unit='mm')
+    assert given.measurement_unit == 'mm' and _unit_notes(given) == []      # given units win
+    np.testing.assert_allclose(given.t_s, t, atol=1e-6)
