@@ -154,6 +154,7 @@ def prepare_outputs(args: argparse.Namespace, *, plot_is_folder: bool) -> None:
     a figure's file name is a file (diagnose's ``FILE.png|DIR``,
     :func:`hyst_id.io.outputs.names_folder`).
     """
+    _refuse_overwriting_inputs(args)
     for opt in ('json', 'params_out', 'sim_out'):
         value = getattr(args, opt, None)
         if value:
@@ -171,6 +172,38 @@ def prepare_outputs(args: argparse.Namespace, *, plot_is_folder: bool) -> None:
                               f'(several); give a folder name, e.g. {path.with_suffix("")}')
         else:
             make_output_folder(path.parent, '--plot', plot)
+
+
+#: Arguments naming files a command reads, and those naming files it writes.
+_INPUTS = ('recording', 'params', 'sim', 'domains')
+_OUTPUTS = ('json', 'params_out', 'sim_out', 'plot')
+
+
+def _refuse_overwriting_inputs(args: argparse.Namespace) -> None:
+    """A :class:`ConfigError` when an output would overwrite an input or another output.
+
+    ``--json run.csv`` on ``run.csv`` would replace the recording by the
+    result; an output that is an existing file inside an input bag folder
+    (its ``metadata.yaml`` or ``.mcap``) would damage the bag.
+    """
+    inputs = [Path(v) for v in (getattr(args, k, None) for k in _INPUTS)
+              if isinstance(v, str) and v and Path(v).exists()]
+    seen: dict[Path, str] = {}
+    for opt in _OUTPUTS:
+        value = getattr(args, opt, None)
+        if not value or (opt == 'plot' and names_folder(Path(value))):
+            continue
+        flag, out = '--' + opt.replace('_', '-'), Path(value).resolve()
+        for src in inputs:
+            here = src.resolve()
+            if out == here or (here.is_dir() and out.is_file() and here in out.parents):
+                what = f'the input {src}' if out == here else f'a file of the input {src}'
+                raise ConfigError(f'{flag} {value}: that is {what}, which the output would '
+                                  'overwrite; give another file name')
+        if out in seen:
+            raise ConfigError(f'{flag} {value}: {seen[out]} writes the same file; give each '
+                              'output its own name')
+        seen[out] = flag
 
 
 def make_settings(args: argparse.Namespace) -> IdentifySettings:

@@ -88,6 +88,13 @@ def run(args: argparse.Namespace) -> int:
                                             and args.time_scale > 0.0):
         raise ConfigError(f'--time-scale must be a finite number > 0, got {args.time_scale}')
     recordings = find_recordings(args.inputs)
+    out = Path(args.out).resolve()      # the fleet's own table and results are no recordings
+    own = [r for r in recordings if out in r.resolve().parents]
+    if own:
+        print(f'note: {len(own)} file(s) under --out {args.out} skipped (this command writes '
+              f'its results there): {", ".join(r.name for r in own[:3])}'
+              f'{" ..." if len(own) > 3 else ""}', file=sys.stderr)
+        recordings = [r for r in recordings if r not in own]
     if not recordings:
         raise ConfigError(f'no recordings found under {", ".join(args.inputs)}')
     make_output_folder(Path(args.out), '--out', args.out)

@@ -262,6 +262,30 @@ def test_outputs_go_into_folders_made_for_them(tmp_path, capsys):
     assert (tmp_path / 'sets' / 'c.yaml').is_file()
 
 
+@pytest.mark.parametrize('command', ['identify', 'diagnose'])
+def test_an_output_never_overwrites_an_input(tmp_path, capsys, command):
+    """``--json run.csv`` on ``run.csv``: refused before any work, the recording intact."""
+    csv = write_csv(tmp_path / 'run.csv')
+    bag = make_bag(tmp_path / 'bag')
+    mcap = next(bag.glob('*.mcap'))
+    before = {p: hashlib.sha256(p.read_bytes()).hexdigest() for p in (csv, mcap)}
+    flags = ['--json'] + (['--params-out'] if command == 'identify' else ['--params-out',
+                                                                          '--plot'])
+    for rec, out in ((csv, csv), (bag, mcap), (bag, bag / 'metadata.yaml')):
+        for flag in flags:
+            code = main([command, str(rec), '--quiet', '--workers', '1', flag, str(out)])
+            err = capsys.readouterr().err
+            assert code == 2 and err.count('\n') == 1, (rec, flag, err)
+            # a --plot that names no figure is taken as a folder, and a file is none
+            assert 'which the output would overwrite' in err or (
+                flag == '--plot' and 'is a file, not a folder' in err), err
+    code = main([command, str(csv), '--quiet', '--json', str(tmp_path / 'a.json'),
+                 '--params-out', str(tmp_path / 'a.json')])
+    assert code == 2 and 'writes the same file' in capsys.readouterr().err
+    assert {p: hashlib.sha256(p.read_bytes()).hexdigest() for p in (csv, mcap)} == before
+    assert not (tmp_path / 'a.json').exists()
+
+
 def test_a_node_params_file_names_what_the_cli_does_not_use(tmp_path, capsys):
     """A node's params file reads its topics; its other parameters are named, not applied."""
     csv = write_csv(tmp_path / 'run.csv')

@@ -145,8 +145,20 @@ def test_cli_fleet_reads_headerless_csv_columns_and_refuses_bad_options(tmp_path
         assert cli_main(args + extra) == 2, extra
         err = capsys.readouterr().err
         assert needle in err and 'internal error' not in err, err
+    # results written among the inputs are not taken for recordings on the next run
+    inside = ['fleet', str(folder), '--out', str(folder / 'results')] + args[4:]
+    assert cli_main(inside + ['--columns', '0,2,1', '--time-scale', '0.001']) == 0
+    assert (folder / 'results' / 'fleet.csv').is_file()
+    capsys.readouterr()
+    assert cli_main(inside + ['--columns', '0,2,1', '--time-scale', '0.001']) == 0
+    assert 'fleet.csv' in capsys.readouterr().err     # named as skipped, not read
     # the ms column read as seconds: the fleet says so, as identify does
     fresh = ['fleet', str(folder), '--out', str(tmp_path / 'out2')] + args[4:]
+    assert cli_main(fresh + ['--columns', '0,2,1']) == 1    # the results' fleet.csv: no time
+    said = capsys.readouterr().out
+    assert "note: run.csv: the time column '#0' is read as seconds" in said, said
+    import shutil
+    shutil.rmtree(folder / 'results')
     assert cli_main(fresh + ['--columns', '0,2,1']) == 0
     said = capsys.readouterr().out
     assert "note: run.csv: the time column '#0' is read as seconds" in said, said
