@@ -59,11 +59,16 @@ def time_unit_hint(label: str, t: np.ndarray) -> str | None:
     The header's words decide when they name a unit (``t_ms``, ``time [us]``);
     a header with none (or a column index) is doubted when the median interval is at
     least 0.5 s, slow for an actuator record; a counter (``index``,
-    ``sample``) is not. The words end with the
-    ``--time-scale`` to give.
+    ``sample``) stepping by one is a sample count, with no period. The words end
+    with the ``--time-scale`` to give.
     """
     words = re.split(r'[^a-zµ]+', label.lower())
     if any(w in _COUNTER_WORDS for w in words):
+        steps = np.diff(t[np.isfinite(t)])
+        if steps.size and float(np.median(steps)) == 1.0:
+            return (f'{TIME_UNIT_NOTE} the time column {label!r} counts samples and is read '
+                    'as seconds (one sample = 1 s); give --time-scale with the sample period '
+                    'in seconds (0.001 at 1 kHz) unless the time does not matter')
         return None
     for pattern, factor in _TIME_UNITS:
         if any(re.fullmatch(pattern, w) for w in words):
@@ -92,6 +97,16 @@ def _number(cell: str, decimal_comma: bool) -> float | None:
         except ValueError:
             return None
     return None
+
+
+#: Header names that say a column is the measurement but not what was measured.
+_GENERIC_MEASUREMENT = frozenset({'measurement', 'measured', 'meas', 'y', 'output', 'out',
+                                  'response', 'value', 'signal', 'data', 'reading', 'sensor'})
+
+
+def _signal_name(label: str) -> str:
+    """The header's name for the measurement, or '' for a generic one (``measurement``)."""
+    return '' if label.strip().lower() in _GENERIC_MEASUREMENT else label
 
 
 def _unit_of(cell: str) -> str:
@@ -226,4 +241,4 @@ def read_csv(path: str | Path, channel: str, *,
                      measurement_unit=measurement_unit, source=str(path),
                      notes=(note,) + ((hint,) if hint else ()),
                      command_name=labels[1] if names else '',
-                     measurement_name=labels[2] if names else '')
+                     measurement_name=_signal_name(labels[2]) if names else '')

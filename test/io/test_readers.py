@@ -394,7 +394,8 @@ def _unit_notes(rec: Recording) -> list[str]:
     ('t', 10, None, 'median sample interval of 10 s'),  # no unit named, slow for an actuator
     ('t', 0.01, None, None),                          # seconds at 100 Hz
     ('t_s', 10, None, None),                          # seconds named: believed
-    ('index', 1, None, None),                         # a sample counter
+    ('index', 1, None, 'counts samples'),             # a sample counter: no period
+    ('sample', 2, None, None),                        # a counter that skips: not one
     ('time_ms', 10, 1e-3, None),                      # the scale given
 ])
 def test_time_unit_hint_for_a_csv_read_as_seconds(
@@ -593,6 +594,9 @@ def test_a_csv_header_names_the_signals_for_words_and_axes(tmp_path: Path) -> No
     assert (named.command_name, named.measurement_name) == ('stroke_mm', 'force_N')
     assert named.quantity == 'force_N' and named.channel == 'position'
     assert named.window(10, 150).quantity == 'force_N'      # a part keeps the names
+    generic = read_recording(_write(tmp_path / 'generic.csv', 't,command,measurement\n' + body),
+                             'pressure')
+    assert generic.quantity == 'pressure'      # not "the measured measurement"
     bare = read_recording(_write(tmp_path / 'bare.csv', body), 'pressure', columns=(0, 1, 2))
     assert (bare.command_name, bare.measurement_name) == ('', '')
     assert bare.quantity == 'pressure'                      # unnamed: the channel
