@@ -109,6 +109,12 @@ def _signal_name(label: str) -> str:
     return '' if label.strip().lower() in _GENERIC_MEASUREMENT else label
 
 
+def _name_and_unit(label: str) -> tuple[str, str]:
+    """``'pos [um]'`` -> ``('pos', 'um')``; a label without a bracketed unit -> ``(label, '')``."""
+    m = re.fullmatch(r'(.*?)\s*[\[(]([^\[\]()]+)[\])]\s*', label)
+    return (m.group(1), m.group(2).strip()) if m and m.group(1) else (label, '')
+
+
 def _unit_of(cell: str) -> str:
     """A unit row's cell without its brackets (``[mm]``, ``(V)``)."""
     return cell.strip().strip('[]()').strip()
@@ -233,12 +239,15 @@ def read_csv(path: str | Path, channel: str, *,
     units = [unit_row[i] for i in index] if unit_row else ['', '', '']
     if unit_row:
         note += f'; units from the row under the header: {", ".join(units)}'
-        command_unit, measurement_unit = command_unit or units[1], measurement_unit or units[2]
-    time_label = f'{labels[0]} [{units[0]}]' if units[0] else labels[0]
+    named = [_name_and_unit(label) for label in labels]     # ``pos [um]``: pos in um
+    units = [u or n[1] for u, n in zip(units, named)]
+    command_unit, measurement_unit = command_unit or units[1], measurement_unit or units[2]
+    time_label = (f'{labels[0]} [{unit_row[index[0]]}]' if unit_row and unit_row[index[0]]
+                  else labels[0])
     hint = None if given_scale else time_unit_hint(time_label, data[:, 0])
     return Recording(t_s=data[:, 0] * float(time_scale), command=data[:, 1],
                      measurement=data[:, 2], channel=channel, command_unit=command_unit,
                      measurement_unit=measurement_unit, source=str(path),
                      notes=(note,) + ((hint,) if hint else ()),
-                     command_name=labels[1] if names else '',
-                     measurement_name=_signal_name(labels[2]) if names else '')
+                     command_name=named[1][0] if names else '',
+                     measurement_name=_signal_name(named[2][0]) if names else '')

@@ -625,3 +625,15 @@ def test_a_decimal_comma_and_a_unit_row_are_read(tmp_path: Path) -> None:
     given = read_csv(units, 'position', time_scale=1e-3, measurement_unit='mm')
     assert given.measurement_unit == 'mm' and _unit_notes(given) == []      # given units win
     np.testing.assert_allclose(given.t_s, t, atol=1e-6)
+
+
+def test_a_tab_separated_header_with_spaces_and_units_in_brackets(tmp_path: Path) -> None:
+    """``time [ms]<TAB>cmd [V]<TAB>pos [um]``: names with spaces, units from the brackets."""
+    path = _write(tmp_path / 'run.txt', 'time [ms]\tcmd [V]\tpos [um]\textra\n' + ''.join(
+        f'{10.0 * i:.1f}\t{np.sin(i / 9):.6f}\t{np.cos(i / 9):.6f}\t0\n' for i in range(200)))
+    got = read_recording(path, 'position', columns=('time [ms]', 'cmd [V]', 'pos [um]'),
+                         time_scale=1e-3)
+    assert got.n_samples == 200 and got.duration_s == pytest.approx(1.99)
+    assert (got.command_name, got.command_unit) == ('cmd', 'V')
+    assert (got.measurement_name, got.measurement_unit, got.quantity) == ('pos', 'um', 'pos')
+    assert read_recording(path, 'position', columns=(0, 1, 2), time_scale=1e-3).n_samples == 200
