@@ -25,7 +25,7 @@ from hyst_id.errors import ConfigError
 from hyst_id.identification import config, IdentifySettings
 from hyst_id.identification.chains import CHAIN_NAMES, ChainSpec
 from hyst_id.io.outputs import make_output_folder, names_folder
-from hyst_id.io.recording import Recording
+from hyst_id.io.recording import gap_note, Recording
 
 __all__ = ['add_output_arguments', 'add_recording_arguments', 'add_settings_arguments',
            'load_recording', 'make_spec', 'make_settings', 'parse_columns', 'prepare_outputs',
@@ -121,8 +121,9 @@ def load_recording(args: argparse.Namespace) -> Recording:
               'GAASS settings and domains as flags)', file=sys.stderr)
     rec = read_recording(args.recording, args.channel, topics=topics,
                          columns=parse_columns(args.columns), time_scale=args.time_scale)
-    for note in time_unit_notes(rec.notes):
-        print(f'note: {note}', file=sys.stderr)
+    for note in time_unit_notes(rec.notes) + [gap_note(rec.t_s)]:
+        if note:
+            print(f'note: {note}', file=sys.stderr)
     return rec
 
 

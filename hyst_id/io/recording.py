@@ -38,6 +38,7 @@ __all__ = [
     'roundoff_probe',
     'validate_part',
     'validate_recording',
+    'gap_note',
 ]
 
 #: Measured channels the chains know about.
@@ -52,6 +53,9 @@ MAX_ABS_VALUE = 1e15
 #: A gap longer than this many median sample intervals means the file holds
 #: more than one run (or lost data) and is refused.
 MAX_GAP_FACTOR = 1000.0
+
+#: A step longer than this many median sample intervals is a gap worth a note.
+GAP_NOTE_FACTOR = 10.0
 
 #: A command whose range is below this share of its largest magnitude excites
 #: nothing (a float32 reading resolves about 6e-8 of its value).
@@ -292,3 +296,25 @@ def roundoff_probe(rec: Recording) -> Recording:
     y = rec.measurement
     return replace(rec, measurement=y * (1.0 + eps * rng.standard_normal(y.shape[0])),
                    command=rec.command * (1.0 + eps * float(rng.standard_normal())))
+
+
+def gap_note(t_s: np.ndarray, factor: float = GAP_NOTE_FACTOR) -> str | None:
+    """Words on the steps longer than ``factor`` median intervals, or None when there are none.
+
+    What the command did over such a gap is not recorded; the chain holds the
+    sample before it, so a sensor's or actuator's dynamics fitted across it
+    take the difference (a lag comes out longer).
+    """
+    dt = np.diff(np.asarray(t_s, dtype=float))
+    if dt.size == 0:
+        return None
+    median_dt = float(np.median(dt))
+    long = np.flatnonzero(dt > factor * median_dt)
+    if long.size == 0:
+        return None
+    k = int(long[np.argmax(dt[long])])
+    return (f'{long.size} gap(s) longer than {factor:g} sample intervals, the longest '
+            f'{dt[k]:.3g} s ({dt[k] / median_dt:.0f} x the median {median_dt:.3g} s) at '
+            f't = {t_s[k]:.6g} s: the command over a gap is not recorded and is held at '
+            'its last sample, which biases fitted dynamics (a lag comes out longer); split '
+            'the record there or give it without gaps')

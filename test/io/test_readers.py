@@ -424,6 +424,28 @@ def test_time_unit_hint_reaches_the_cli(tmp_path: Path, capsys) -> None:
     assert 'time column' not in capsys.readouterr().err
 
 
+def test_a_gap_gets_a_note_on_the_cli(tmp_path: Path, capsys) -> None:
+    """A 2 s hole in a 0.05 s record: said, with where and how long; jitter is not a gap."""
+    import argparse
+    from hyst_id.commands.common import load_recording
+    rng = np.random.default_rng(0)
+    t = np.cumsum(rng.uniform(0.04, 0.06, 800))
+    t[400:] += 2.0
+    path = _write(tmp_path / 'gap.csv', 't,command,measurement\n' + ''.join(
+        f'{a:.4f},{np.sin(a):.6f},{np.cos(a):.6f}\n' for a in t))
+    args = argparse.Namespace(recording=str(path), channel='position', params=None,
+                              columns=None, time_scale=None)
+    load_recording(args)
+    err = capsys.readouterr().err
+    assert 'note: 1 gap(s) longer than 10 sample intervals, the longest 2.0' in err, err
+    assert f't = {t[399]:.6g} s' in err
+    t[400:] -= 2.0
+    _write(path, 't,command,measurement\n' + ''.join(
+        f'{a:.4f},{np.sin(a):.6f},{np.cos(a):.6f}\n' for a in t))
+    load_recording(args)
+    assert 'gap' not in capsys.readouterr().err
+
+
 @pytest.mark.parametrize('name, rows, duration_s', [
     ('Circle_1bar.csv', 7139, 73.508), ('Circle_3bar.csv', 7834, 83.239),
     ('Circle_7bar.csv', 8720, 89.999)])
