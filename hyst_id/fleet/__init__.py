@@ -20,10 +20,11 @@ a process pool or on a Dask cluster, writes one JSON per recording, skips
 recordings already done, and reports a bad recording in its row without
 stopping; :func:`write_table` writes the table (CSV, and Parquet when
 ``pyarrow`` is installed); :func:`loop_trends` flags valves whose loop width
-or backlash drifts over their recordings (the maintenance signal).
+drifts over their recordings (the maintenance signal).
 
 Modules: :mod:`.run` (finding, the task, the engines), :mod:`.table`
-(rows, files, trends). May import :mod:`hyst_id.io`,
+(rows, files, trends), :mod:`.width` (the identified loop's width in command
+units). May import :mod:`hyst_id.io`,
 :mod:`hyst_id.identification`, :mod:`hyst_id.diagnosis`; never rclpy.
 """
 

@@ -130,8 +130,11 @@ def fleet_task(path: str, options: FleetOptions) -> dict:
         settings = make_settings(seeds=options.seeds, generations=options.generations,
                                  workers=1)
         ident = identify(rec, spec=spec, settings=settings)
+        from hyst_id.fleet.width import loop_width_command
         doc.update(status='ok', identification=ident.to_dict(), n_samples=rec.n_samples,
-                   duration_s=rec.duration_s, source=rec.source, notes=list(rec.notes))
+                   duration_s=rec.duration_s, source=rec.source, notes=list(rec.notes),
+                   loop_width_command=loop_width_command(
+                       ident, (float(rec.command.min()), float(rec.command.max()))))
         if options.diagnose:
             from hyst_id.diagnosis import diagnose
             doc['diagnosis'] = diagnose(rec).to_dict()

@@ -18,8 +18,13 @@ A row holds the recording, its valve (the parent directory's name unless a
 ``valve_of`` function says otherwise), status and error, the start of the
 recording (seconds since the epoch, when its stamps say), %e_r, the noise
 floor and their ratio, every identified parameter (``p.<name>``), the loop
-width and backlash width (tk family: ``c_r - c_l`` and ``c_br - c_bl``),
-warnings, poorly determined parameters, and the diagnosis verdict.
+width in command units (:func:`hyst_id.fleet.width.loop_width_command`: the
+whole chain's quasi-static loop, however H and the backlash share it), the
+parameter differences ``h_width`` (tk family: ``c_r - c_l``) and
+``backlash_width`` (``c_br - c_bl``), warnings, poorly determined parameters,
+and the diagnosis verdict. Trends are fitted to the loop width: the share
+between H and the backlash moves from fit to fit (a new-user trial's widening
+play was missed on ``c_r - c_l`` and ``c_br - c_bl``), the whole loop does not.
 """
 
 from __future__ import annotations
@@ -62,7 +67,8 @@ def fleet_rows(docs: Iterable[dict],
                 'channel': ident.get('channel'), 'family': ident.get('family'),
                 'er_percent': er, 'noise_floor_percent': floor,
                 'er_over_floor': er / floor if er is not None and floor else None,
-                'loop_width': _diff(params, 'c_r', 'c_l'),
+                'loop_width': doc.get('loop_width_command'),
+                'h_width': _diff(params, 'c_r', 'c_l'),
                 'backlash_width': _diff(params, 'c_br', 'c_bl'),
                 'warnings': ' | '.join(ident.get('warnings') or []),
                 'poorly_determined': ' '.join(sorted(ident.get('poorly_determined') or {})),
@@ -113,8 +119,8 @@ def write_table(rows: list[dict[str, Any]], out_dir: str | Path) -> list[Path]:
 
 
 def loop_trends(rows: list[dict[str, Any]],
-                metrics: tuple[str, ...] = ('loop_width', 'backlash_width')) -> list[dict]:
-    """Valves whose loop width or backlash drifts over their recordings.
+                metrics: tuple[str, ...] = ('loop_width',)) -> list[dict]:
+    """Valves whose loop width (or another of ``metrics``) drifts over their recordings.
 
     Per valve (at least three good recordings, ordered by start time, else by
     name) a straight line is fitted to each metric against the recording's
