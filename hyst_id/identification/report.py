@@ -30,7 +30,11 @@ from hyst_id.identification.quality import floor_says_nothing
 from hyst_id.io.jsonable import jsonable
 from hyst_id.io.recording import Recording
 
-__all__ = ['format_table', 'write_json', 'plot_identification', 'er_of']
+__all__ = ['MEAN_NOT_A_MODEL', 'format_table', 'write_json', 'plot_identification', 'er_of']
+
+#: The mean of the runs' parameters is called no model when its %e_r exceeds this
+#: multiple of the runs' median %e_r (the runs sit on different, equally good sets).
+MEAN_NOT_A_MODEL = 2.0
 
 
 def format_table(ident: Identification, truth: dict | None = None) -> str:
@@ -70,7 +74,10 @@ def format_table(ident: Identification, truth: dict | None = None) -> str:
         '-' * len(head),
         f'%e_r best run        {_num(ident.er_percent, 8, 3)}   ' + _floor_ratio(
             ident.er_percent, floor),
-        f'%e_r mean params     {_num(ident.er_mean_params_percent, 8, 3)}'
+        f'%e_r mean params     {_num(ident.er_mean_params_percent, 8, 3)}' + (
+            '   (not a model: the runs found different parameter sets that fit alike, and '
+            'their mean fits none; use the best run)'
+            if ident.er_mean_params_percent > MEAN_NOT_A_MODEL * np.median(er) else '')
         if np.isfinite(ident.er_mean_params_percent) else
         '%e_r mean params          n/a  (the mean of the runs is not a valid loop)',
         f'%e_r over runs       median {_num(np.median(er), 0, 3)}  worst '
