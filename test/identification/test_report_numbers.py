@@ -91,7 +91,7 @@ def test_a_fit_below_what_noise_allows_says_the_floor_is_too_high():
 
 
 def test_a_mean_of_the_runs_that_fits_nothing_is_called_no_model():
-    """A play seen from its middle: ten runs at 2.08 %, the mean of their sets at 90.9 %."""
+    """Runs on different, equally good sets (a play seen from its middle): their mean is none."""
     from dataclasses import replace
     t = np.arange(0.0, 20.0, 0.01)
     v = 5 * np.sin(2 * np.pi * 0.2 * t)
