@@ -44,10 +44,10 @@ from hyst_id.identification.incumbent import (
     rank_conventions,
     search_subset,
 )
-from hyst_id.identification.quality import assess, FIT_FACTOR
+from hyst_id.identification.quality import assess
 from hyst_id.identification.refine import refine
 from hyst_id.identification.result import Identification, IdentifySettings, SeedRun
-from hyst_id.identification.start_state import left_out_note, refit_start
+from hyst_id.identification.start_state import keep_refit, left_out_note, refit_start
 from hyst_id.identification.workers import map_in_processes, n_processes, WorkersStopped
 from hyst_id.io.recording import Recording, roundoff_probe, validate_recording
 from hyst_id.signals.noise import noise_floor_percent
@@ -249,7 +249,8 @@ def identify(recording: Recording, *, spec: ChainSpec | None = None,
     restart('probing from the first reversal')
     probe = _identify(rest, spec, replace(full, seeds=full.seeds[:2], global_runs=0, hops=0),
                       None, None, should_stop)
-    if not probe.er_percent * FIT_FACTOR < before * probe.noise_floor_percent:
+    if not (probe.noise_floor_percent > 0
+            and keep_refit(before, probe.er_percent / probe.noise_floor_percent)):
         return ident        # (also when the rest's floor is 0: nothing to judge by)
     restart('GAASS seeds, from the first reversal')
     again = _identify(rest, spec, full, progress, on_generation, should_stop)

@@ -37,7 +37,14 @@ import numpy as np
 from hyst_id.identification.quality import FIT_FACTOR, floor_says_nothing
 from hyst_id.signals.reversals import reversal_indices
 
-__all__ = ['MIN_BEFORE', 'MIN_KEEP', 'left_out_note', 'refit_start']
+__all__ = ['MIN_BEFORE', 'MIN_KEEP', 'NEAR_FACTOR', 'RETRY_FACTOR', 'keep_refit',
+           'left_out_note', 'refit_start']
+
+#: A fit further than this from its noise floor is tried again from the first reversal.
+RETRY_FACTOR = 1.1
+#: A probe from the first reversal within this of its floor, and this much closer to it
+#: than the whole record's fit, is kept (a mild start inside the play: 1.24 x -> 1.0 x).
+NEAR_FACTOR = 1.1
 
 #: Share of the samples that must lie after the first reversal for a refit from there.
 MIN_KEEP = 0.5
@@ -58,13 +65,13 @@ def refit_start(command: np.ndarray, er_percent: float, floor_percent: float) ->
     Returns
     -------
     int or None
-        None when the fit is within :data:`FIT_FACTOR` of the floor or the
+        None when the fit is within :data:`RETRY_FACTOR` of the floor or the
         floor says nothing (:func:`~hyst_id.identification.quality.floor_says_nothing`), the
         command reverses fewer than three times, fewer than
         :data:`MIN_BEFORE` samples lie before the first reversal, or less
         than :data:`MIN_KEEP` of them after it.
     """
-    if (not FIT_FACTOR * floor_percent < er_percent
+    if (not RETRY_FACTOR * floor_percent < er_percent
             or floor_says_nothing(er_percent, floor_percent)):
         return None     # at the floor, or a noise-free record (no ratio to judge by)
     index, _ = reversal_indices(np.asarray(command, dtype=float))
@@ -74,6 +81,19 @@ def refit_start(command: np.ndarray, er_percent: float, floor_percent: float) ->
     if k < MIN_BEFORE or n - k < MIN_KEEP * n:
         return None
     return k
+
+
+def keep_refit(before: float, probe: float) -> bool:
+    """Whether a probe from the first reversal beats the whole record's fit clearly.
+
+    ``before`` and ``probe``: each fit's %e_r over its noise floor. Kept when
+    the probe is :data:`~hyst_id.identification.quality.FIT_FACTOR` (1.5) times
+    closer to its floor, or within :data:`NEAR_FACTOR` of it and that much
+    closer: a start inside the play that costs the whole fit only a quarter
+    above its floor still bends every parameter (a sensor lag 30 % long).
+    """
+    return probe * FIT_FACTOR < before or (probe <= NEAR_FACTOR
+                                           and probe * NEAR_FACTOR < before)
 
 
 def left_out_note(t_s: np.ndarray, index: int, before: float, after: float) -> str:
