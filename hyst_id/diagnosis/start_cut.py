@@ -87,7 +87,7 @@ def start_cut(rec: Recording, command_model: np.ndarray, spec: ChainSpec,
     -------
     StartCut or None
     """
-    k = refit_start(rec.command, er_train_percent, floor_train_percent)
+    k = refit_start(rec.command, er_train_percent, floor_train_percent, factor=FIT_FACTOR)
     if k is None:
         return None
     rest_t = rec.t_s[k:]

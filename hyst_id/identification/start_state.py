@@ -52,7 +52,8 @@ MIN_KEEP = 0.5
 MIN_BEFORE = 5
 
 
-def refit_start(command: np.ndarray, er_percent: float, floor_percent: float) -> int | None:
+def refit_start(command: np.ndarray, er_percent: float, floor_percent: float,
+                factor: float = RETRY_FACTOR) -> int | None:
     """The first reversal's sample, when a fit from there is worth trying.
 
     Parameters
@@ -61,17 +62,21 @@ def refit_start(command: np.ndarray, er_percent: float, floor_percent: float) ->
         Command samples of the fitted record.
     er_percent, floor_percent : float
         The fit's %e_r and the record's noise floor.
+    factor : float
+        A fit within this multiple of the floor is not tried again
+        (:data:`RETRY_FACTOR`; a diagnosis's start cut passes
+        :data:`~hyst_id.identification.quality.FIT_FACTOR`).
 
     Returns
     -------
     int or None
-        None when the fit is within :data:`RETRY_FACTOR` of the floor or the
+        None when the fit is within ``factor`` of the floor or the
         floor says nothing (:func:`~hyst_id.identification.quality.floor_says_nothing`), the
         command reverses fewer than three times, fewer than
         :data:`MIN_BEFORE` samples lie before the first reversal, or less
         than :data:`MIN_KEEP` of them after it.
     """
-    if (not RETRY_FACTOR * floor_percent < er_percent
+    if (not factor * floor_percent < er_percent
             or floor_says_nothing(er_percent, floor_percent)):
         return None     # at the floor, or a noise-free record (no ratio to judge by)
     index, _ = reversal_indices(np.asarray(command, dtype=float))

@@ -26,7 +26,9 @@ probe from the first reversal 0.97-0.99 x (the bound :data:`PROBE_NEAR` is 1.3).
 
 from __future__ import annotations
 
+import numpy as np
 from play_reference import rest_then_sine
+import pytest
 
 from hyst_id.diagnosis import diagnose, DiagnoseSettings
 from hyst_id.diagnosis.start_cut import PROBE_NEAR
@@ -70,3 +72,22 @@ def test_start_state_off_never_tries_the_cut(monkeypatch):
     assert asked == []
     diagnose(rec, settings=SETTINGS)
     assert len(asked) == 1
+
+
+def test_the_cut_is_tried_only_above_one_and_a_half_times_the_floor(monkeypatch):
+    """identify retries from 1.1 x its floor; a diagnosis's baseline keeps the 1.5 x it had.
+
+    So the blind family's verdicts and times (measured with 1.5 x) stand: a baseline
+    at 1.4 x is no reason to cut, and the probe is never run for it.
+    """
+    import hyst_id.diagnosis.start_cut as start_cut_module
+    from hyst_id.identification.chains import chain_spec
+    rec = rest_then_sine(0, 20.0, True, sine_s=40.0)
+
+    def no_probe(*args, **kwargs):
+        raise AssertionError('the probe ran')
+    monkeypatch.setattr(start_cut_module, 'identify', no_probe)
+    v = np.asarray(rec.command)
+    assert start_cut_module.start_cut(rec, v, chain_spec('position'), SETTINGS, 1.4, 1.0) is None
+    with pytest.raises(AssertionError, match='the probe ran'):
+        start_cut_module.start_cut(rec, v, chain_spec('position'), SETTINGS, 1.6, 1.0)
