@@ -76,10 +76,10 @@ from hyst_id.diagnosis.select import (
     hold_calls,
     round_record,
 )
-from hyst_id.diagnosis.split_notes import level_note, range_note
+from hyst_id.diagnosis.split_notes import level_note, range_note, require_split
 from hyst_id.diagnosis.start_cut import start_cut
 from hyst_id.diagnosis.trial import try_all
-from hyst_id.errors import ConfigError, RecordingError
+from hyst_id.errors import ConfigError
 from hyst_id.identification.chains import chain_spec, ChainSpec
 from hyst_id.io.recording import Recording, roundoff_probe, validate_part, validate_recording
 from hyst_id.signals.noise import floor_percent
@@ -202,9 +202,7 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
     mechs = get_mechanisms(settings.mechanisms, channel=rec.channel)
     t, v_orig, y = rec.t_s, rec.command, rec.measurement
     n_train = split_index(t, settings.train_fraction)
-    if n_train < 20 or t.size - n_train < 10:
-        raise RecordingError(f'record too short to split: {n_train} training and '
-                             f'{t.size - n_train} held-out samples')
+    require_split(n_train, t.size)
     if spec is None:
         lo, hi = float(np.min(v_orig[:n_train])), float(np.max(v_orig[:n_train]))
         half = 0.5 * (hi - lo) if hi > lo else 1.0

@@ -66,9 +66,9 @@ from hyst_id.diagnosis.select import (
     FitResult,
     round_record,
 )
-from hyst_id.diagnosis.split_notes import range_note
+from hyst_id.diagnosis.split_notes import range_note, require_split
 from hyst_id.diagnosis.stick_events import bands_from_demand
-from hyst_id.errors import ConfigError, HystIdError, RecordingError
+from hyst_id.errors import ConfigError, HystIdError
 from hyst_id.identification.chains import er_percent
 from hyst_id.io.recording import Recording, roundoff_probe, validate_recording
 from hyst_id.signals.noise import floor_percent
@@ -305,9 +305,7 @@ def _diagnose_sim(recording, base, settings, say):
     rec = roundoff_probe(validate_recording(recording))
     t, v, y, ch = rec.t_s, rec.command, rec.measurement, rec.channel
     n_train = split_index(t, settings.train_fraction)
-    if n_train < 20 or t.size - n_train < 10:
-        raise RecordingError(f'record too short to split: {n_train} training and '
-                             f'{t.size - n_train} held-out samples')
+    require_split(n_train, t.size)
     ids = settings.mechanisms or SIM_EFFECTS
     unknown = [i for i in ids if i not in MECHANISMS]
     if unknown:

@@ -12,15 +12,33 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
-"""Notes on a diagnosis's time split: held-out commands or levels beyond the training part."""
+"""A diagnosis's time split: big enough to judge by, and notes on what it holds out."""
 
 from __future__ import annotations
 
 import numpy as np
 
+from hyst_id.errors import RecordingError
 from hyst_id.signals.split import level_excursion
 
-__all__ = ['level_note', 'range_note']
+__all__ = ['MIN_HELDOUT_SAMPLES', 'MIN_TRAIN_SAMPLES', 'level_note', 'range_note',
+           'require_split']
+
+#: Fewest training samples a diagnosis fits blocks on: the chain has 11-13 parameters
+#: and a block up to three more; on 35 (a new-user trial's 50-sample record) a
+#: 1.2-sample dead time was claimed on a record that had none.
+MIN_TRAIN_SAMPLES = 100
+#: Fewest held-out samples a block is judged on.
+MIN_HELDOUT_SAMPLES = 40
+
+
+def require_split(n_train: int, n_total: int) -> None:
+    """A :class:`RecordingError` when the split leaves too few samples to judge a block by."""
+    if n_train < MIN_TRAIN_SAMPLES or n_total - n_train < MIN_HELDOUT_SAMPLES:
+        raise RecordingError(
+            f'record too short to diagnose: {n_train} training and {n_total - n_train} '
+            f'held-out samples (need at least {MIN_TRAIN_SAMPLES} and '
+            f'{MIN_HELDOUT_SAMPLES} to judge a block); identify can still fit it')
 
 
 def range_note(v: np.ndarray, n_train: int, n_judged: int | None = None) -> list[str]:

@@ -328,6 +328,11 @@ def test_bad_inputs_are_one_line_errors():
     with pytest.raises(RecordingError) as info:
         diagnose(short, settings=FAST)
     assert '\n' not in str(info.value)
+    t = np.arange(50) * 0.02        # a new-user trial's 50 samples: a dead time was claimed
+    v = 9.0 + np.sin(2 * np.pi * 3.0 * t)
+    fifty = Recording(t, v, v + np.random.default_rng(0).normal(0, 0.01, t.size), 'pressure')
+    with pytest.raises(RecordingError, match='too short to diagnose: 35 training and 15'):
+        diagnose(fifty, settings=FAST)
     flat = Recording(rec.t_s, np.full_like(rec.t_s, 9.0), rec.measurement, 'position')
     with pytest.raises(NoExcitationError):
         diagnose(flat, settings=FAST)
