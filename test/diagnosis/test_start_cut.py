@@ -75,7 +75,7 @@ def test_start_state_off_never_tries_the_cut(monkeypatch):
 
 
 def test_the_cut_is_tried_only_above_one_and_a_half_times_the_floor(monkeypatch):
-    """identify retries from 1.1 x its floor; a diagnosis's baseline keeps the 1.5 x it had.
+    """Identify retries from 1.1 x its floor; a diagnosis's baseline keeps the 1.5 x it had.
 
     So the blind family's verdicts and times (measured with 1.5 x) stand: a baseline
     at 1.4 x is no reason to cut, and the probe is never run for it.

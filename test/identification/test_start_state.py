@@ -88,7 +88,9 @@ def _mild(seed: int) -> Recording:
 
 @pytest.mark.parametrize('seed', [0, 1])
 def test_a_mild_start_inside_the_play_is_left_out_too(seed):
-    """The whole record fits 1.21-1.25 x its floor with the lag 31-33 % long (noise seeds
+    """A fit a quarter above its floor is tried from the first reversal too.
+
+    The whole record fits 1.21-1.25 x its floor with the lag 31-33 % long (noise seeds
     0-2, these settings): below the 1.5 x that used to trigger the retry, so the lag was
     reported wrong with no sign. From the first reversal: 0.979-0.997 x, the lag within 1.2 %.
     """
