@@ -105,3 +105,19 @@ def test_a_mean_of_the_runs_that_fits_nothing_is_called_no_model():
             for k, i in lines.items()}
     assert 'not a model' not in said['near'], said
     assert 'not a model' in said['far'] and 'use the best run' in said['far'], said
+
+
+def test_a_lag_on_the_position_chain_is_pointed_at_the_sensor_chains():
+    """A play behind a 0.3 s sensor fitted as position: the warning names --channel pressure."""
+    from play_reference import play
+    from reference_sim import first_order_sensor
+    t = np.arange(0.0, 60.0, 0.05)
+    u = 5 * np.sin(2 * np.pi * t / 10.0)
+    y = first_order_sensor(t, 2.0 * play(u, 0.8, -0.8), 0.3)
+    y = y + np.random.default_rng(0).normal(0, 0.01, t.size)
+    settings = IdentifySettings(seeds=(0,), workers=1, global_runs=0, hops=0, start_state=False)
+    ident = identify(Recording(t, u, y, 'position'), settings=settings)
+    said = [w for w in ident.warnings if 'x the noise floor' in w]
+    assert said and '--channel pressure' in said[0] and 'hyst-id diagnose' in said[0], said
+    ident = identify(Recording(t, u, y, 'pressure'), settings=settings)
+    assert not any('--channel pressure' in w for w in ident.warnings), ident.warnings
