@@ -26,7 +26,7 @@ import numpy as np
 
 from hyst_id.io.recording import Recording
 
-__all__ = ['play', 'rest_then_sine']
+__all__ = ['mild_start', 'play', 'rest_then_sine']
 
 
 def play(u: np.ndarray, half_width: float, y0: float) -> np.ndarray:
@@ -46,3 +46,18 @@ def rest_then_sine(seed: int, rest_s: float, inside: bool, sine_s: float) -> Rec
         2 * np.pi * 0.013 * s)))
     y = 2.0 * play(u, 0.8, 0.0 if inside else -0.8) + 1.0
     return Recording(t, u, y + np.random.default_rng(seed).normal(0, 0.01, t.size), 'position')
+
+
+def mild_start(seed: int) -> Recording:
+    """A new-user trial's case: a sine from 0 in the middle of a play, behind a 0.15 s lag.
+
+    ``y = lag(0.13 play(u, 20) + 5)`` on the pressure chain, ``u`` the decaying 10 s sine
+    of Eq. 24 scaled to ±150, 100 s at 20 Hz, noise 0.5 % of the span; the lag is the
+    reference simulator's first-order sensor (written apart from the package too).
+    """
+    from reference_sim import first_order_sensor
+    t = np.arange(0.0, 100.0, 0.05)
+    u = 150.0 * np.exp(-0.01 * t) * np.sin(2 * np.pi * t / 10.0)
+    y = first_order_sensor(t, 0.13 * play(u, 20.0, 0.0) + 5.0, 0.15)
+    y = y + np.random.default_rng(seed).normal(0.0, 0.005 * np.ptp(y), t.size)
+    return Recording(t, u, y, 'pressure')
