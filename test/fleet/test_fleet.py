@@ -205,7 +205,18 @@ def test_an_interrupted_local_fleet_keeps_what_arrived_and_ends_its_workers(tmp_
     proc = subprocess.Popen([sys.executable, '-c', _INTERRUPTED_FLEET, str(tmp_path)],
                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     try:
-        workers = [int(proc.stdout.readline().split()[1]) for _ in range(2)]
+        # the two workers' 'slow PID' lines; anything else the process says is kept for
+        # the message (a CI run under load once read a line without a PID here)
+        said, workers = [], []
+        while len(workers) < 2:
+            line = proc.stdout.readline()
+            if not line:
+                break
+            said.append(line)
+            words = line.split()
+            if len(words) == 2 and words[0] == 'slow' and words[1].isdigit():
+                workers.append(int(words[1]))
+        assert len(workers) == 2, said
         deadline = time.monotonic() + 20.0      # the fast row written (its result read)
         while not list((tmp_path / 'recordings').glob('*.json')) and \
                 time.monotonic() < deadline:
