@@ -42,6 +42,7 @@ import numpy as np
 
 from hyst_id.diagnosis.baseline import identify_base
 from hyst_id.diagnosis.result import DiagnoseSettings
+from hyst_id.diagnosis.split_notes import MIN_HELDOUT_SAMPLES, MIN_TRAIN_SAMPLES
 from hyst_id.identification import identify, IdentifySettings
 from hyst_id.identification.chains import ChainSpec
 from hyst_id.identification.quality import FIT_FACTOR
@@ -92,8 +93,8 @@ def start_cut(rec: Recording, command_model: np.ndarray, spec: ChainSpec,
         return None
     rest_t = rec.t_s[k:]
     n_train = split_index(rest_t, settings.train_fraction)
-    if n_train < 20:
-        return None
+    if n_train < MIN_TRAIN_SAMPLES or rest_t.size - n_train < MIN_HELDOUT_SAMPLES:
+        return None     # the record from there is too short to diagnose (require_split)
     part = Recording(rest_t[:n_train], command_model[k:k + n_train],
                      rec.measurement[k:k + n_train], rec.channel, source=rec.source)
     probe = identify(part, spec=spec, settings=IdentifySettings(**{

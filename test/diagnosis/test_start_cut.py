@@ -91,3 +91,28 @@ def test_the_cut_is_tried_only_above_one_and_a_half_times_the_floor(monkeypatch)
     assert start_cut_module.start_cut(rec, v, chain_spec('position'), SETTINGS, 1.4, 1.0) is None
     with pytest.raises(AssertionError, match='the probe ran'):
         start_cut_module.start_cut(rec, v, chain_spec('position'), SETTINGS, 1.6, 1.0)
+
+
+def test_no_cut_leaves_a_record_too_short_to_diagnose(monkeypatch):
+    """A cut whose rest would fail the split's minimum is not tried.
+
+    The record is then diagnosed whole, instead of the diagnosis after the cut refusing
+    it (100 training and 40 held-out samples, ``split_notes.require_split``).
+    """
+    import hyst_id.diagnosis.start_cut as start_cut_module
+    from hyst_id.identification.chains import chain_spec
+    from hyst_id.io.recording import Recording
+
+    def no_probe(*args, **kwargs):
+        raise AssertionError('the probe ran')
+    monkeypatch.setattr(start_cut_module, 'identify', no_probe)
+    for n, probed in ((150, False), (400, True)):       # first reversal at sample 15
+        t = np.arange(n) * 0.05
+        v = np.sin(2 * np.pi * t / 3.0)
+        rec = Recording(t, v, v, 'position')
+        if probed:
+            with pytest.raises(AssertionError, match='the probe ran'):
+                start_cut_module.start_cut(rec, v, chain_spec('position'), SETTINGS, 3.0, 1.0)
+        else:
+            assert start_cut_module.start_cut(rec, v, chain_spec('position'), SETTINGS,
+                                              3.0, 1.0) is None
