@@ -184,9 +184,9 @@ def fit_warnings(ident: Identification) -> list[str]:
                    f'misses by %e_r {ident.er_percent:.4g}: the model misses part of the '
                    'response; look at the residual plot')
     elif floor > 0 and ident.er_percent > FIT_FACTOR * floor:
-        hint = {'position': '; a measurement that follows the command with a lag has sensor '
-                'dynamics the position chain lacks: try --channel pressure (a first-order '
-                'sensor) or flow (second order)'}.get(ident.channel, '')
+        hint = ('; a measurement that follows the command with a lag has sensor dynamics '
+                'the position chain lacks: try --channel pressure (a first-order sensor) or '
+                'flow (second order)' if ident.channel == 'position' else '')
         out.append(f'the best %e_r is {ident.er_percent / floor:.1f} x the noise floor: the '
                    'model misses part of the response (unmodelled dynamics, drift, a loop '
                    "shape it cannot make); look at the residual plot, and 'hyst-id diagnose' "
