@@ -197,9 +197,9 @@ def read_csv(path: str | Path, channel: str, *,
     names = first if not all(_number(c, comma) is not None for c in first) else None
     rows = lines[1:] if names is not None else lines
     unit_row = None
-    if names is not None and rows and len(split(rows[0][1])) == len(first) and all(
-            _number(c, comma) is None for c in split(rows[0][1]) if c):
-        unit_row = [_unit_of(c) for c in split(rows[0][1])]   # ``[s];[V];[um]`` under a header
+    second = split(rows[0][1]) if names is not None and rows else []
+    if len(second) == len(first) and all(_number(c, comma) is None for c in second if c):
+        unit_row = [_unit_of(c) for c in second]    # ``[s];[V];[um]`` under a header
         rows = rows[1:]
     if not rows:
         raise RecordingError(f'no data rows in {path}: only a header')
@@ -236,14 +236,13 @@ def read_csv(path: str | Path, channel: str, *,
             data[r, j] = value
     note = (f'columns: t_s = {labels[0]} x {time_scale:g}, command = {labels[1]}, '
             f'measurement = {labels[2]}')
-    units = [unit_row[i] for i in index] if unit_row else ['', '', '']
+    row_units = [unit_row[i] for i in index] if unit_row else ['', '', '']
     if unit_row:
-        note += f'; units from the row under the header: {", ".join(units)}'
+        note += f'; units from the row under the header: {", ".join(row_units)}'
     named = [_name_and_unit(label) for label in labels]     # ``pos [um]``: pos in um
-    units = [u or n[1] for u, n in zip(units, named)]
+    units = [u or n[1] for u, n in zip(row_units, named)]
     command_unit, measurement_unit = command_unit or units[1], measurement_unit or units[2]
-    time_label = (f'{labels[0]} [{unit_row[index[0]]}]' if unit_row and unit_row[index[0]]
-                  else labels[0])
+    time_label = f'{labels[0]} [{row_units[0]}]' if row_units[0] else labels[0]
     hint = None if given_scale else time_unit_hint(time_label, data[:, 0])
     return Recording(t_s=data[:, 0] * float(time_scale), command=data[:, 1],
                      measurement=data[:, 2], channel=channel, command_unit=command_unit,

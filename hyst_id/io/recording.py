@@ -33,12 +33,12 @@ from hyst_id.signals.split import split_index
 
 __all__ = [
     'CHANNELS',
+    'gap_note',
     'Recording',
     'ROUNDOFF_PROBE_ENV',
     'roundoff_probe',
     'validate_part',
     'validate_recording',
-    'gap_note',
 ]
 
 #: Measured channels the chains know about.
