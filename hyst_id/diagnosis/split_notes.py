@@ -26,7 +26,7 @@ __all__ = ['MIN_HELDOUT_SAMPLES', 'MIN_TRAIN_SAMPLES', 'level_note', 'range_note
 
 #: Fewest training samples a diagnosis fits blocks on: the chain has 11-13 parameters
 #: and a block up to three more; on 35 (a new-user trial's 50-sample record) a
-#: 1.2-sample dead time was claimed on a record that had none.
+#: dead time was claimed on a record that had none.
 MIN_TRAIN_SAMPLES = 100
 #: Fewest held-out samples a block is judged on.
 MIN_HELDOUT_SAMPLES = 40
