@@ -188,7 +188,9 @@ from hyst_id.fleet import FleetOptions, run as fleet_run
 def task(path, options):
     if path.endswith('fast'):
         return {'recording': path, 'status': 'ok'}
-    print('slow', os.getpid(), flush=True)
+    # one write(2) of a short line to a pipe is atomic: print's separate writes from the two
+    # workers once interleaved into 'slowslow 12494' on a CI machine
+    os.write(1, f'slow {os.getpid()}\n'.encode())
     time.sleep(60.0)
 
 
