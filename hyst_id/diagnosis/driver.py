@@ -385,7 +385,8 @@ def gain_call(findings: list[Finding], final_loc: Localization, library: set[str
     at 1.03 x the floor with the level term at t = 7.2. Whether a gain or an
     offset drifts is then a judgement call, and the offset finding says so:
     a growing trend names ``gain_drift``, a falling one ``supply_decay``
-    (where the channel's library has it). Nothing changes when a time-gain
+    (pressure and flow) or ``gain_loss`` (position), where the channel's
+    library has it. Nothing changes when a time-gain
     block is already a finding or the gain already one of the finding's
     alternatives.
     """
@@ -393,8 +394,9 @@ def gain_call(findings: list[Finding], final_loc: Localization, library: set[str
     level_t = float(final_loc.trend['level_t'])
     if 'offset_drift' not in ids or abs(level_t) <= LEVEL_TREND_T:
         return
-    gain = 'gain_drift' if level_t > 0 else 'supply_decay'
-    if gain not in library or ids & {'gain_drift', 'supply_decay'}:
+    gain = ('gain_drift' if level_t > 0
+            else 'supply_decay' if 'supply_decay' in library else 'gain_loss')
+    if gain not in library or ids & {'gain_drift', 'supply_decay', 'gain_loss'}:
         return
     f = next(f for f in findings if f.mechanism == 'offset_drift')
     if gain in {a['mechanism'] for a in f.alternatives}:

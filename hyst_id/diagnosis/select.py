@@ -62,7 +62,7 @@ from hyst_id.identification.chains import er_percent
 
 __all__ = ['Criteria', 'Data', 'FitResult', 'Comparison', 'evaluate', 'fit_model', 'polish',
            'compare', 'choose', 'close_calls', 'alternatives_record', 'explained_share',
-           'HOLD_CALL_SAMPLES', 'hold_calls',
+           'HOLD_CALL_SAMPLES', 'NESTS', 'hold_calls',
            'improvement_z', 'passes_holdout', 'round_record']
 
 
@@ -398,17 +398,26 @@ def passes_holdout(comp: Comparison, criteria: Criteria) -> bool:
             and comp.share >= criteria.min_share)
 
 
+#: Blocks that nest another (a falling gain about a distant zero is an offset ramp): while the
+#: nested one is accepted and within the judgement ratio, one wins only with its own located
+#: evidence (> 0). Blind #118 and #38, offset drifts, went to ``gain_loss`` without this.
+NESTS = {'gain_loss': 'offset_drift'}
+
+
 def choose(comparisons: list[Comparison], data: Data, criteria: Criteria
            ) -> tuple[Comparison | None, list[Comparison]]:
     """Pick the accepted candidate: held-out error, then BIC among ties, then evidence.
 
-    Returns the winner (None when nothing is accepted) and the other
-    candidates tied with it (equally consistent with the data).
+    A nesting block without evidence steps back (:data:`NESTS`). Returns the winner (None
+    when nothing is accepted) and the others tied with it (equally consistent with the data).
     """
     ok = [c for c in comparisons if c.accepted]
     if not ok:
         return None, []
     er = {id(c): data.judged_er_percent(c.fit) for c in ok}
+    mine = {c.mechanism: c for c in ok}
+    ok = [c for c in ok if not ((m := mine.get(NESTS.get(c.mechanism))) and c.evidence <= 0.0
+                                and er[id(m)] <= criteria.judgement_ratio * er[id(c)])]
     best = min(ok, key=lambda c: er[id(c)])
     rows = data.judged_rows
     near = max(criteria.tie_ratio * er[id(best)],

@@ -72,7 +72,7 @@ def test_gain_drift_is_registered_with_words():
 def test_a_steady_gain_claims_no_drift():
     d = diagnose(_recording(5, lambda t: np.ones_like(t)), settings=SETTINGS)
     found = {f.mechanism for f in d.findings}
-    assert not found & {'gain_drift', 'supply_decay', 'offset_drift'}, found
+    assert not found & {'gain_drift', 'gain_loss', 'supply_decay', 'offset_drift'}, found
 
 
 @pytest.mark.parametrize('mech', ['gain_drift', 'supply_decay'])

@@ -41,7 +41,8 @@ TRUTH = np.array([1.01, 1.05, 0.10, 0.15, -0.25, 0.50, 14.0, 7.0, 1.0, -0.15, 0.
 
 #: Blocks inverted on data (the others' ``undo`` is None by design: filters, end stops,
 #: a replaced actuator or a map of the position are not inverted on noisy samples).
-INVERTIBLE = {'dead_time', 'offset_drift', 'gain_drift', 'supply_decay', 'creep', 'friction'}
+INVERTIBLE = {'dead_time', 'offset_drift', 'gain_drift', 'gain_loss', 'supply_decay', 'creep',
+              'friction'}
 
 
 def _record(t):
@@ -77,7 +78,7 @@ def test_undo_leaves_what_the_chain_alone_explains(mech_id):
     assert sse <= 1e-16 * float(y_u @ y_u)
 
 
-@pytest.mark.parametrize('gain_id', ['gain_drift', 'supply_decay'])
+@pytest.mark.parametrize('gain_id', ['gain_drift', 'gain_loss', 'supply_decay'])
 def test_a_gain_in_time_undone_before_friction_leaves_the_chain_alone(gain_id):
     """The gain is divided out of friction's term too; neither undo nor undo_terms edits terms."""
     gain, friction = MECHANISMS[gain_id], MECHANISMS['friction']

@@ -27,6 +27,7 @@ from hyst_id.diagnosis.mechanisms import (
     dead_time,
     friction,
     gain_drift,
+    gain_loss,
     loop_shape,
     offset_drift,
     rate_dependence,
@@ -45,7 +46,7 @@ __all__ = ['MECHANISMS', 'MECHANISM_IDS', 'Context', 'Mechanism', 'Quantity', 'g
 #: Every mechanism by id, in the issue's order.
 MECHANISMS: dict[str, Mechanism] = {m.MECHANISM.id: m.MECHANISM for m in (
     dead_time, sensor_lag, supply_decay, offset_drift, saturation, stiction,
-    static_nonlinearity, rate_dependence, loop_shape, gain_drift, creep,
+    static_nonlinearity, rate_dependence, loop_shape, gain_drift, gain_loss, creep,
     actuator_dynamics, friction)}
 
 #: The ids alone.
