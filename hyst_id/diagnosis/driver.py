@@ -76,7 +76,7 @@ from hyst_id.diagnosis.select import (
     hold_calls,
     round_record,
 )
-from hyst_id.diagnosis.split_notes import level_note, range_note, require_split
+from hyst_id.diagnosis.split_notes import level_note, range_note, require_split, swing_note
 from hyst_id.diagnosis.start_cut import start_cut
 from hyst_id.diagnosis.trial import try_all
 from hyst_id.errors import ConfigError
@@ -333,6 +333,8 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
     _final_corrections(findings, mechs, current, ctx, v_orig)
     final_loc = loc if current is not baseline else loc0
     gain_call(findings, final_loc, {m.id for m in mechs})
+    notes += swing_note(t, v_orig, [f.mechanism for f in findings]
+                        + [a['mechanism'] for f in findings for a in f.alternatives])
     empirical = None
     if current.er_holdout_percent > UNKNOWN_FACTOR * floor_h:
         say('empirical block: what a model could still gain')
