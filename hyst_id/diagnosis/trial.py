@@ -47,7 +47,8 @@ from hyst_id.io.recording import Recording
 __all__ = ['polish_all', 'try_all', 'try_mechanism']
 
 #: Mechanisms whose fits cost the most, handed to workers first (the rest keep their order).
-COSTLY_FIRST = ('loop_shape', 'actuator_dynamics', 'friction', 'creep', 'saturation')
+COSTLY_FIRST = ('loop_shape', 'actuator_dynamics', 'friction', 'bouc_wen', 'creep',
+                'saturation')
 
 
 def try_all(mechs: list[Mechanism], current: FitResult, data: Data, ctx: Context,

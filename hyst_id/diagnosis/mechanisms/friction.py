@@ -117,6 +117,8 @@ class Friction(Mechanism):
     names = ('presliding_fraction',)
     units = ('1',)
     n_linear = 1
+    #: what turns round after a reversal, in the words of ``presliding``
+    turns = 'force'
 
     def bounds(self, ctx: Context) -> np.ndarray:
         """Presliding travel per :data:`_LENGTH`."""
@@ -172,8 +174,7 @@ class Friction(Mechanism):
         own = [c for k, c in terms.items() if k.startswith(f'{self.id}:')]
         return v, (y - np.sum(own, axis=0)) if own else y
 
-    @staticmethod
-    def _force_and_change(coef, labels, span) -> tuple[float, float]:
+    def _force_and_change(self, coef, labels, span) -> tuple[float, float]:
         """The friction force and the reading's change over the travel (both measured).
 
         The change is the static map of the travel from its bottom to its top:
@@ -183,7 +184,7 @@ class Friction(Mechanism):
         """
         labels = list(labels)
         c = dict(zip(labels, (float(x) for x in coef)))
-        force = c['friction:0']
+        force = c[f'{self.id}:0']
         gain = c['sensor'] + c.get('creep:0', 0.0)
         if 'quantity:1' in c:            # the static curve's basis z, z^2, z^3
             change = curve_change(gain, c.get('quantity:2', 0.0))
@@ -192,26 +193,36 @@ class Friction(Mechanism):
             change = gain * (hi - lo)
         return force, change
 
-    def describe(self, theta, coef, info, ctx) -> dict[str, Quantity]:
-        """The force in measurement units, the presliding travel in command units."""
+    def _band(self, theta, info, ctx) -> tuple[float, dict[str, Quantity]]:
+        """The band's signed half-height, and the values every Dahl block reports.
+
+        Those are the reading's change over the travel and the presliding
+        travel in command units.
+        """
         force, change = self._force_and_change(info['coef'], info['labels'], info['span'])
         lo, hi = info['span']
         presliding = float(theta[0]) * (hi - lo) / max(abs(info['pos_per_cmd']), 1e-300)
+        return force, {'reading_change': Quantity(change, ctx.meas_unit,
+                                                  "the reading's own change over the travel, "
+                                                  'bottom to top (the static map)'),
+                       'presliding': Quantity(presliding, ctx.cmd_unit,
+                                              f'travel over which the {self.turns} turns '
+                                              'round after a reversal (1/e of the gap left)')}
+
+    def describe(self, theta, coef, info, ctx) -> dict[str, Quantity]:
+        """The force in measurement units, the presliding travel in command units."""
+        force, common = self._band(theta, info, ctx)
+        change = common['reading_change'].value
         return {'friction_force': Quantity(abs(force), ctx.meas_unit,
                                            'sliding friction: half the height of the band '
                                            'between rising and falling motion'),
                 'higher_while_rising': Quantity(float(force > 0.0), 'bool',
                                                 '1 if the reading is higher while the command '
                                                 'rises (a clockwise loop against it)'),
-                'reading_change': Quantity(change, ctx.meas_unit,
-                                           "the reading's own change over the travel, "
-                                           'bottom to top (the static map)'),
                 'leads_motion': Quantity(float(force * change > 0.0), 'bool',
                                          '1 if the band runs against the sense of the '
                                          "chain's own loop (a force with the motion)"),
-                'presliding': Quantity(presliding, ctx.cmd_unit,
-                                       'travel over which the force turns round after a '
-                                       'reversal (1/e of the gap left)')}
+                **common}
 
     def implausible(self, theta, coef, span, noise_std, ctx=None, labels=None) -> str:
         """A band below the noise, or one running the hysteresis's way on a sloped reading.
@@ -219,7 +230,7 @@ class Friction(Mechanism):
         Sloped: the reading changes over the travel by more than the band's
         height (twice the force).
         """
-        if coef is None or labels is None or 'friction:0' not in labels:
+        if coef is None or labels is None or f'{self.id}:0' not in labels:
             return ''
         force, change = self._force_and_change(coef, labels, span)
         if abs(force) < noise_std:

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 from hyst_id.diagnosis.mechanisms import (
     actuator_dynamics,
+    bouc_wen,
     creep,
     dead_time,
     friction,
@@ -47,7 +48,7 @@ __all__ = ['MECHANISMS', 'MECHANISM_IDS', 'Context', 'Mechanism', 'Quantity', 'g
 MECHANISMS: dict[str, Mechanism] = {m.MECHANISM.id: m.MECHANISM for m in (
     dead_time, sensor_lag, supply_decay, offset_drift, saturation, stiction,
     static_nonlinearity, rate_dependence, loop_shape, gain_drift, gain_loss, creep,
-    actuator_dynamics, friction)}
+    actuator_dynamics, friction, bouc_wen)}
 
 #: The ids alone.
 MECHANISM_IDS = tuple(MECHANISMS)
