@@ -72,8 +72,26 @@ def try_all(mechs: list[Mechanism], current: FitResult, data: Data, ctx: Context
     Returns
     -------
     list of Comparison
-        One per mechanism, in the order of ``mechs``.
+        One per mechanism, in the order of ``mechs``. A block that fits as another
+        of the round (:attr:`~hyst_id.diagnosis.mechanisms.base.Mechanism.fits_as`)
+        is judged on that block's fit, made once.
     """
+    ids = [m.id for m in mechs]
+    twin = {i: ids.index(m.fits_as) for i, m in enumerate(mechs) if m.fits_as in ids}
+    own = [i for i in range(len(mechs)) if i not in twin]
+    got = dict(zip(own, _fit_and_judge([mechs[i] for i in own], current, data, ctx, settings,
+                                       loc, chain_starts, say)))
+    for i, j in twin.items():
+        say(f'{mechs[i].id}: the fit of {mechs[j].id}, judged as {mechs[i].id}')
+        got[i] = _as_twin(mechs[i], got[j].fit, current, data, ctx, settings, loc)
+    return [got[i] for i in range(len(mechs))]
+
+
+def _fit_and_judge(mechs: list[Mechanism], current: FitResult, data: Data, ctx: Context,
+                   settings: DiagnoseSettings, loc: Localization,
+                   chain_starts: list[np.ndarray],
+                   say: Callable[[str], None]) -> list[Comparison]:
+    """:func:`try_mechanism` of each of ``mechs``, in this process or in workers."""
     workers = n_processes(settings.workers, len(mechs))
     if workers <= 1:
         comps = []
@@ -161,6 +179,28 @@ def try_mechanism(m: Mechanism, current: FitResult, data: Data, ctx: Context,
                 continue
             if fit is None or got.sse_train < fit.sse_train:
                 fit = got
+    return _judge(m, current, fit, data, ctx, settings, loc, screened)
+
+
+def _as_twin(m: Mechanism, fit: FitResult, current: FitResult, data: Data, ctx: Context,
+             settings: DiagnoseSettings, loc: Localization) -> Comparison:
+    """``m`` judged on ``fit``, the fit of the block ``m`` fits as, under ``m``'s name.
+
+    The same parameters in the same places: the model is rebuilt with ``m``
+    in its twin's place and evaluated once at the fitted vector.
+    """
+    prev = fit.model
+    model = ComposedModel(ctx.channel, [m if pm.id == m.fits_as else pm
+                                        for pm in prev.mechanisms], ctx,
+                          prev.bounds[:prev.n_chain], family=prev.spec.family.id,
+                          swapped_by=prev.swapped_by, hold=prev.hold)
+    return _judge(m, current, evaluate(model, data, fit.p, fit.nfev), data, ctx, settings, loc)
+
+
+def _judge(m: Mechanism, current: FitResult, fit: FitResult, data: Data, ctx: Context,
+           settings: DiagnoseSettings, loc: Localization,
+           screened: FitResult | None = None) -> Comparison:
+    """Judge ``fit`` (``current`` extended by ``m``): criteria, evidence, plausibility."""
     comp = compare(current, fit, data, m.id, settings.criteria)
     comp.screened = screened
     comp.evidence, comp.where = m.evidence(loc)

@@ -135,3 +135,33 @@ def test_a_family_swaps_search_comes_back_from_its_worker_and_is_not_repeated(mo
     again = try_all(mechs[:1], current, data, ctx, replace(settings, workers=1), loc, [])
     np.testing.assert_array_equal(again[0].fit.p, first[0].fit.p)
     assert again[0].fit.sse_train == first[0].fit.sse_train
+
+
+def test_a_block_that_fits_as_another_is_judged_on_that_fit_made_once(monkeypatch):
+    """``bouc_wen`` fits as ``friction``: in a round with both, the fit is made once.
+
+    Its comparison is the one its own fit gives (the same arithmetic under another name),
+    judged in its own sense; ``friction``'s is unchanged.
+    """
+    data, ctx, current, loc = delayed_case()
+    both = get_mechanisms(('friction', 'bouc_wen'), channel='position')
+    settings = DiagnoseSettings(fit_budget=200, workers=1)
+    alone = [try_all([m], current, data, ctx, settings, loc, [])[0] for m in both]
+    fitted, lines = [], []
+    real = trial.try_mechanism
+
+    def counted(m, *args):
+        fitted.append(m.id)
+        return real(m, *args)
+
+    monkeypatch.setattr(trial, 'try_mechanism', counted)
+    round_ = try_all(both, current, data, ctx, settings, loc, [], lines.append)
+    assert fitted == ['friction']
+    assert any('bouc_wen: the fit of friction' in line for line in lines)
+    for own, shared in zip(alone, round_):
+        assert (own.mechanism, own.status, own.accepted) == (shared.mechanism, shared.status,
+                                                             shared.accepted)
+        np.testing.assert_array_equal(own.fit.p, shared.fit.p)
+        np.testing.assert_array_equal(own.fit.coef, shared.fit.coef)
+        assert own.fit.labels == shared.fit.labels and own.holdout_z == shared.holdout_z
+    assert 'bouc_wen:0' in round_[1].fit.labels and round_[1].fit.model.ids[-1] == 'bouc_wen'

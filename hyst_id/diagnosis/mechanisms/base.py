@@ -169,6 +169,11 @@ class Mechanism:
         Whether :meth:`quantity` replaces the reading's map of the travel by a
         basis of its own (a static curve); blocks that only add terms
         (:meth:`quantity_terms`, friction) leave the map alone.
+    fits_as : str
+        The id of a block whose fit is this block's under another name (the same
+        parameters, bounds, starts and model; only the sense it accepts and its
+        words differ), or ''. In a round that tries both the fit is made once
+        (:func:`hyst_id.diagnosis.trial.try_all`).
     """
 
     id = ''  # noqa: A003 - the issue's word for a mechanism's name
@@ -183,6 +188,7 @@ class Mechanism:
     families: tuple[str, ...] | None = None
     channels: tuple[str, ...] | None = None
     maps_travel = False
+    fits_as = ''
 
     # -- fitting -----------------------------------------------------------
     def bounds(self, ctx: Context) -> np.ndarray:

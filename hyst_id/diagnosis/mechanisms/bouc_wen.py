@@ -62,6 +62,8 @@ class BoucWen(Friction):
     #: with it (docs/diagnosis.md, "Physics from simulators written apart")
     channels = ('position',)
     turns = 'state'
+    #: friction's fit, judged in the other sense: a round that tries both fits once
+    fits_as = 'friction'
     placement = ('a term of the travel after the backlash B, through the sensor: a state '
                  'that lags the motion and turns round smoothly after each reversal')
     physics = ("the actuator's own hysteresis as a Bouc-Wen state (a piezo stack, a "
