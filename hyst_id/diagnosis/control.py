@@ -38,7 +38,7 @@ from hyst_id.diagnosis.model import ComposedModel
 from hyst_id.diagnosis.select import compare, Comparison, Criteria, Data, evaluate, FitResult
 from hyst_id.diagnosis.select import passes_holdout, polish
 
-__all__ = ['drop_superseded', 'equivalent_chain', 'null_control', 'recheck']
+__all__ = ['drop_superseded', 'equivalent_chain', 'null_control', 'recheck', 'without']
 
 
 def null_control(candidate: Comparison, current: FitResult, data: Data, *,
@@ -120,6 +120,23 @@ def recheck(comparisons: list[Comparison], null: FitResult, data: Data,
     return lost
 
 
+def without(current: FitResult, mid: str, data: Data, *, max_nfev: int) -> FitResult | None:
+    """``current`` with block ``mid`` taken out, the rest polished from the current values.
+
+    None when the rest, as the current values pack it, is not feasible.
+    """
+    prev = current.model
+    keep = [m for m in prev.mechanisms if m.id != mid]
+    model = ComposedModel(prev.channel, keep, prev.ctx, prev.bounds[:prev.n_chain],
+                          family=prev.spec.family.id, swapped_by=prev.swapped_by,
+                          hold=prev.hold)
+    p0 = model.pack(current.p[:prev.n_chain], {m.id: prev.theta(current.p, m.id) for m in keep})
+    if not model.feasible(p0):
+        return None
+    p, _, nfev = polish(model, data, p0, max_nfev=max_nfev)
+    return evaluate(model, data, p, nfev)
+
+
 def drop_superseded(current: FitResult, order: list[str], data: Data, criteria: Criteria,
                     *, max_nfev: int) -> tuple[FitResult, list[str]]:
     """Withdraw blocks the others make redundant (backward elimination).
@@ -143,16 +160,9 @@ def drop_superseded(current: FitResult, order: list[str], data: Data, criteria: 
     while current.model is not None and len(current.model.mechanisms) > 1:
         prev = current.model
         for mid in [i for i in order if i in prev.slices and i not in dropped]:
-            keep = [m for m in prev.mechanisms if m.id != mid]
-            model = ComposedModel(prev.channel, keep, prev.ctx, prev.bounds[:prev.n_chain],
-                                  family=prev.spec.family.id, swapped_by=prev.swapped_by,
-                                  hold=prev.hold)
-            p0 = model.pack(current.p[:prev.n_chain],
-                            {m.id: prev.theta(current.p, m.id) for m in keep})
-            if not model.feasible(p0):
+            reduced = without(current, mid, data, max_nfev=max_nfev)
+            if reduced is None:
                 continue
-            p, _, nfev = polish(model, data, p0, max_nfev=max_nfev)
-            reduced = evaluate(model, data, p, nfev)
             if not compare(reduced, current, data, mid, criteria).accepted:
                 current = reduced
                 dropped.append(mid)

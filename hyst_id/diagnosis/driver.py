@@ -61,6 +61,7 @@ from hyst_id.diagnosis.challenge import chain_fit, challenge, withdrawn_note
 from hyst_id.diagnosis.control import drop_superseded, equivalent_chain, null_control
 from hyst_id.diagnosis.control import recheck
 from hyst_id.diagnosis.empirical import empirical_block
+from hyst_id.diagnosis.exchange import exchanged_call, exchanges
 from hyst_id.diagnosis.locate import LEVEL_TREND_T, Localization, locate, noise_std
 from hyst_id.diagnosis.mechanisms import get_mechanisms
 from hyst_id.diagnosis.mechanisms.base import Context, Mechanism
@@ -242,7 +243,7 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
                                 'baseline_over_floor': cut.before_ratio,
                                 'probe_over_floor': cut.probe_ratio}
         return d
-    current, loc, findings, rounds = baseline, loc0, [], []
+    current, loc, findings, rounds, round_comps = baseline, loc0, [], [], {}
     blocked = BlockedCV(data)
     rechosen, chain_notes = False, []
     for round_no in range(settings.max_mechanisms):
@@ -304,6 +305,7 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
                 f'{trained:.4g} -> {winner.fit.er_train_percent:.4g}')
         findings.append(finding_from(winner, current, mech, loc, ctx, v_orig))
         findings[-1].alternatives = alternatives
+        round_comps[winner.mechanism] = comps
         findings[-1].blocked_cv = blocked.confirm(current, winner.fit)
         current = winner.fit
         loc = locate(t, v_orig, y, current.prediction, sigma, n_train, ctx.period_s)
@@ -319,6 +321,18 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
         if dropped:
             findings = [f for f in findings if f.mechanism not in dropped]
             loc = locate(t, v_orig, y, current.prediction, sigma, n_train, ctx.period_s)
+
+    def relocate(fit):
+        return locate(t, v_orig, y, fit.prediction, sigma, n_train, ctx.period_s)
+    for x in exchanges(current, [f.mechanism for f in findings], round_comps, mechs, data, ctx,
+                       settings, chain_starts, relocate, say):
+        mech = next(m for m in mechs if m.id == x.comparison.mechanism)
+        old, findings[x.index] = findings[x.index], finding_from(
+            x.comparison, x.before, mech, relocate(x.before), ctx, v_orig)
+        findings[x.index].alternatives = [exchanged_call(x, data)] + [
+            a for a in old.alternatives if a['mechanism'] != mech.id]
+        findings[x.index].blocked_cv = blocked.confirm(x.before, x.comparison.fit)
+        current, loc = x.comparison.fit, relocate(x.comparison.fit)
     withdrawn: list[str] = []   # claims that the wider chain alone does as well as
     if findings:
         wider = challenge(current, baseline, rec_train, spec, settings, data, ctx, say,
