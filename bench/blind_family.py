@@ -510,6 +510,9 @@ def main() -> int:
     ap.add_argument('--from-json', action='store_true',
                     help='only reprint the tables from docs/diagnosis_blind.json (with '
                     '--diagnose-workers K: of a run one at a time in K processes)')
+    ap.add_argument('--merge', metavar='ROWS_JSON',
+                    help='with --from-json: the rows of ROWS_JSON (a rerun of some '
+                         'recordings, --rows-out) in place of the documented ones')
     ap.add_argument('--write-md', action='store_true',
                     help='with --from-json: write them to docs/diagnosis_blind.md too (after '
                     'bench/blind_effect_costs.py added its figures)')
@@ -546,8 +549,15 @@ def main() -> int:
     if args.from_json:
         k = args.diagnose_workers
         rows = json.loads((ROOT / 'docs' / 'diagnosis_blind.json').read_text())
+        if args.merge:
+            again = {r['index']: r for r in json.loads(Path(args.merge).read_text())}
+            rows = [again.get(r['index'], r) for r in rows]
+            print(f'the documented rows with {len(again)} from {args.merge} in their place')
         text = summary(rows, 'one worker each' if k <= 1 else f'one at a time in {k} processes')
         print(text)
+        if args.write_md and args.merge:
+            print('--write-md writes the documented run only (not with --merge)')
+            return 2
         if args.write_md:
             _write_md(text, len(rows), k)
         return 0
