@@ -531,6 +531,10 @@ def main() -> int:
                     help='start no new recording after M minutes (a full run resumes from '
                          'docs/diagnosis_blind.partial.jsonl next time)')
     args = ap.parse_args()
+    for given in (args.compare, args.against, args.merge):
+        if given and not Path(given).is_file():
+            print(f'blind_family: no such rows file: {given}', file=sys.stderr)
+            return 2
     if args.csv:
         return write_csv(Path(args.csv), args.indices or list(range(args.n)))
     if args.compare:
