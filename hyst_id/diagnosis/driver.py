@@ -229,7 +229,10 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
     baseline, chain_starts = chain_fit(rec_train, spec, settings, data, ctx)
     floor_h = floor_percent(y[n_train:], sigma)
     floor_t = floor_percent(y[:n_train], sigma)
-    loc0 = locate(t, v_orig, y, baseline.prediction, sigma, n_train, ctx.period_s)
+
+    def relocate(fit: FitResult) -> Localization:     # where ``fit`` departs from y
+        return locate(t, v_orig, y, fit.prediction, sigma, n_train, ctx.period_s)
+    loc0 = relocate(baseline)
     say(f'baseline: %e_r train {baseline.er_train_percent:.4g}, held-out '
         f'{baseline.er_holdout_percent:.4g} (noise floor {floor_h:.3g})')
     cut = (start_cut(rec, v, spec, settings, baseline.er_train_percent, floor_t)
@@ -264,7 +267,7 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
         if null is not None and recheck(comps, null, data, settings.criteria):
             rsay(f"{winner.mechanism} was the chain refit's doing")
             current = null
-            loc = locate(t, v_orig, y, current.prediction, sigma, n_train, ctx.period_s)
+            loc = relocate(current)
             winner, alternatives = _choose(comps, data, settings.criteria, blocked, rsay)
         rounds.append(round_record(round_no + 1, comps, winner, data))
         if winner is None and not rechosen:
@@ -275,7 +278,7 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
                     'the held-out part better')
                 chain_notes.append(_rechosen_note(current, other, data))
                 current, rechosen = other, True
-                loc = locate(t, v_orig, y, current.prediction, sigma, n_train, ctx.period_s)
+                loc = relocate(current)
                 continue
         if winner is None:
             break
@@ -308,7 +311,7 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
         round_comps[winner.mechanism] = comps
         findings[-1].blocked_cv = blocked.confirm(current, winner.fit)
         current = winner.fit
-        loc = locate(t, v_orig, y, current.prediction, sigma, n_train, ctx.period_s)
+        loc = relocate(current)
     notes = list(rec.notes) + range_note(v_orig, n_train, data.judged_rows.size) + chain_notes
     if len(findings) > 1:
         current, dropped = drop_superseded(current, [f.mechanism for f in findings], data,
@@ -320,10 +323,7 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
                          '(it stood in for what a later block explains)')
         if dropped:
             findings = [f for f in findings if f.mechanism not in dropped]
-            loc = locate(t, v_orig, y, current.prediction, sigma, n_train, ctx.period_s)
-
-    def relocate(fit):
-        return locate(t, v_orig, y, fit.prediction, sigma, n_train, ctx.period_s)
+            loc = relocate(current)
     for x in exchanges(current, [f.mechanism for f in findings], round_comps, mechs, data, ctx,
                        settings, chain_starts, relocate, say):
         mech = next(m for m in mechs if m.id == x.comparison.mechanism)
@@ -342,7 +342,7 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
             say(f"{' and '.join(ids)} withdrawn: the chain alone, searched wider, does as well")
             notes.append(withdrawn_note(ids, *wider, data))
             findings, current, withdrawn = [], wider[0], ids
-            loc = locate(t, v_orig, y, current.prediction, sigma, n_train, ctx.period_s)
+            loc = relocate(current)
     _refresh_values(findings, mechs, current, ctx, v_orig)      # the values the set holds
     _final_corrections(findings, mechs, current, ctx, v_orig)
     final_loc = loc if current is not baseline else loc0

@@ -20,7 +20,7 @@ around the chain of that round. When a second effect is still missing then (a
 static curve, an end stop, a drift), the held-out part is mostly *its* miss,
 and the lag block that predicts it best need not be the one the record has:
 on the blind family (``bench/blind_family.py``) a sensor lag with a static
-curve (#24) was named ``dead_time``, a dead time with a drift (#106)
+curve (#24) was named ``dead_time``, a sensor lag with an offset drift (#38)
 ``actuator_dynamics``, although the right block fitted the training part
 better in that round.
 
@@ -65,7 +65,7 @@ class Exchange:
     comparison: Comparison      # the rival judged against ``before`` (its own trial)
     before: FitResult           # the final model without the replaced block
     against_final: Comparison   # the rival's model judged against the final model
-    replaced_judged_percent: float  # the final model's judged held-out %e_r, replaced block in
+    replaced_final: FitResult   # that final model, the replaced block in
 
 
 def exchanges(current: FitResult, found: list[str], rounds: dict[str, list[Comparison]],
@@ -98,28 +98,33 @@ def exchanges(current: FitResult, found: list[str], rounds: dict[str, list[Compa
     found = list(found)
     by_id = {m.id: m for m in mechs}
     for i, mid in enumerate(list(found)):
-        rivals = [by_id[c.mechanism] for c in rounds.get(mid, [])
-                  if c.mechanism in LAGS and c.mechanism not in found
-                  and c.mechanism in by_id
-                  and (c.accepted or c.status == 'training only')]
-        if mid not in LAGS or not rivals or len(current.model.mechanisms) < 2:
+        if mid not in LAGS or len(current.model.mechanisms) < 2:
             continue
-        before = without(current, mid, data, max_nfev=2 * settings.fit_budget)
+        rivals = [by_id[c.mechanism] for c in rounds.get(mid, [])
+                  if c.mechanism in LAGS and c.mechanism in by_id and c.mechanism not in found
+                  and (c.accepted or c.status == 'training only')]
+        before = without(current, mid, data, max_nfev=2 * settings.fit_budget) if rivals else None
         if before is None:
             continue
         say(f'exchange: {", ".join(m.id for m in rivals)} in the place of {mid}, '
             'with the other blocks in')
         tried = try_all(rivals, before, data, ctx, settings, relocate(before), chain_starts)
-        judged = [(c, compare(current, c.fit, data, c.mechanism, settings.criteria))
-                  for c in tried if c.accepted]
-        judged = [(c, j) for c, j in judged if _better(j, settings.criteria)]
+        judged = []
+        for c in tried:
+            j = compare(current, c.fit, data, c.mechanism, settings.criteria)
+            ok = c.accepted and _better(j, settings.criteria)
+            say(f'exchange: {c.mechanism} in the place of {mid}, against the final model: '
+                f'training BIC {j.delta_bic:+.0f}, held-out z {j.holdout_z:+.1f}, share '
+                f'{j.share:.0%}, gain {j.gain:.1%}, own trial {c.status}: '
+                + ('better' if ok else 'not better'))
+            if ok:
+                judged.append((c, j))
         if not judged:
             continue
         comp, against = min(judged, key=lambda cj: data.judged_er_percent(cj[0].fit))
         say(f'exchange: {comp.mechanism} replaces {mid}')
         made.append(Exchange(index=i, replaced=mid, comparison=comp, before=before,
-                             against_final=against,
-                             replaced_judged_percent=data.judged_er_percent(current)))
+                             against_final=against, replaced_final=current))
         found[i], current = comp.mechanism, comp.fit
     return made
 
@@ -138,8 +143,8 @@ def _better(j: Comparison, criteria: Criteria) -> bool:
 def exchanged_call(x: Exchange, data: Data) -> dict:
     """The replaced finding as its successor's stated alternative (kind ``exchanged``)."""
     return {'mechanism': x.replaced, 'kind': 'exchanged',
-            'er_holdout_after_percent': float(x.replaced_judged_percent),
-            'er_judged_after_percent': float(x.replaced_judged_percent),
+            'er_holdout_after_percent': float(x.replaced_final.er_holdout_percent),
+            'er_judged_after_percent': float(data.judged_er_percent(x.replaced_final)),
             'er_judged_chosen_percent': float(data.judged_er_percent(x.comparison.fit)),
             'holdout_z': float(x.against_final.holdout_z),
             'delta_bic': float(x.against_final.delta_bic)}
