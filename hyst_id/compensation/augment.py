@@ -305,6 +305,17 @@ class Augmentation:
             desired = (desired - c - self.offset(elapsed_s)) / self.gain(elapsed_s) + c
         return self.invert_output_map(desired)
 
+    def reading(self, model_output: float, elapsed_s: float | None) -> float:
+        """The reading for ``model_output`` at ``elapsed_s``: :meth:`model_target` undone.
+
+        Without a time (``None``) only the output map is applied.
+        """
+        y = self.output_map(model_output) if self.has_output_map else float(model_output)
+        if elapsed_s is None:
+            return y
+        c = self.gain_centre
+        return c + self.gain(elapsed_s) * (y - c) + self.offset(elapsed_s)
+
     def _held(self, elapsed_s: float) -> float:
         t = max(float(elapsed_s), 0.0)
         return min(t, self.schedule_horizon_s) if self.schedule_horizon_s > 0.0 else t
@@ -412,6 +423,18 @@ class AugmentedCompensator:
         if t_s - t_old <= 0.0:
             return desired
         return desired + aug.dead_time_s * (desired - d_old) / (t_s - t_old)
+
+    def predicted_reading(self, model_output: float, t_s: float | None) -> float:
+        """The reading at ``t_s`` of ``model_output``: output map and schedules at ``t_s``.
+
+        What a tracker on top compares the measurement with, so that a drift
+        the schedule takes is not corrected twice (:mod:`~hyst_id.compensation.tracking`).
+        """
+        aug = self.augmentation
+        if self.inner.model is None or self.inner.bypass or not aug.active:
+            return float(model_output)
+        elapsed = None if t_s is None or self._t0 is None else t_s - self._t0
+        return aug.reading(model_output, elapsed)
 
     def step(self, desired: float, t_s: float | None = None) -> float:
         """Command for one desired output sample (``t_s`` needed by time-based corrections)."""

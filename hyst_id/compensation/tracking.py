@@ -34,7 +34,7 @@ the late error).
 
 Acceptance: the correction is applied only while it predicts the recent
 readings clearly better than the nominal model does (exponentially weighted
-a-priori squared error below :data:`ACCEPT_RATIO` x the nominal model's):
+a-priori squared error below :data:`ACCEPT_RATIO` x the nominal model's),
 and while the gain is inside its bounds (an estimate pinned at a bound is
 not believed): a tracker fed by a prediction that does not describe the
 plant (wrong sensor dynamics) then leaves the inverse alone.
@@ -268,6 +268,13 @@ class AdaptiveCompensator:
 
     Call :meth:`step` with each desired sample (returns the command), then
     :meth:`observe` with the reading that command produced.
+
+    The compensator may be an
+    :class:`~hyst_id.compensation.augment.AugmentedCompensator` (what a
+    diagnosis found, in-line): the prediction is then the augmented model's
+    (its output map and schedules at the reading's time, the model output
+    sent its dead time before), so the tracker follows only what the
+    schedules leave, and its correction is asked of the augmented model.
     """
 
     def __init__(self, compensator: Compensator, tracker: GainOffsetTracker,
@@ -276,9 +283,16 @@ class AdaptiveCompensator:
         self.tracker = tracker
         self.sensor = sensor
         self._nominal: float | None = None
+        self._sent: deque[tuple[float, float]] = deque()   # (t_s, model output) still due
         self._saturated = False
         self._t_cmd: float | None = None
         self._t_obs: float | None = None
+
+    @property
+    def dead_time_s(self) -> float:
+        """How long before a reading the model output it is compared with was sent."""
+        aug = getattr(self.compensator, 'augmentation', None)
+        return 0.0 if aug is None else float(aug.dead_time_s)
 
     def step(self, desired: float, t_s: float) -> float:
         """Command for one desired sample at ``t_s``."""
@@ -289,7 +303,21 @@ class AdaptiveCompensator:
         sign = 1.0 if model is None else model.output_sign
         self._nominal = sign * self.compensator.state[2]
         self._t_cmd = t_s
+        if self.dead_time_s > 0.0:
+            self._sent.append((t_s, self._nominal))
         return v
+
+    def _due(self, t_s: float) -> float | None:
+        """The model output sent a dead time before ``t_s`` (the last one without a delay)."""
+        delay = self.dead_time_s
+        if delay <= 0.0:
+            return self._nominal
+        sent, due = self._sent, t_s - delay + 1e-6     # stamps to the microsecond
+        while len(sent) > 1 and sent[1][0] <= due:
+            sent.popleft()
+        if not sent or sent[0][0] > due:
+            return None                  # nothing sent that long ago yet
+        return sent[0][1]
 
     def observe(self, measured: float, t_s: float, dt_s: float | None = None) -> float:
         """Update the tracker with the reading at ``t_s``, ``dt_s`` after the previous one.
@@ -300,8 +328,12 @@ class AdaptiveCompensator:
         if dt_s is None:
             dt_s = 0.0 if self._t_obs is None else max(t_s - self._t_obs, 0.0)
         self._t_obs = t_s
-        if self._nominal is None:
+        nominal = self._due(t_s)
+        if nominal is None:
             return float('nan')
-        predicted = self.sensor.advance(self._nominal, dt_s)
+        predicted = self.sensor.advance(nominal, dt_s)
+        reading = getattr(self.compensator, 'predicted_reading', None)
+        if reading is not None:
+            predicted = reading(predicted, t_s)
         self.tracker.update(t_s, predicted, measured, self._saturated)
         return predicted

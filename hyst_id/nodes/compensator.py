@@ -36,7 +36,10 @@ model's prediction (:mod:`hyst_id.compensation.tracking`; a supply running
 down, a drifting gain or sensor offset), correcting the desired value by
 them; every change of the tracker's state is logged with its reason and the
 estimate is on ``/diagnostics``. The sensor parameters come from
-``tracking.*`` or from the identified-parameters topic.
+``tracking.*`` or from the identified-parameters topic. With in-line
+corrections (``augment.*``) the prediction is the augmented model's, so the
+tracker follows what the schedules leave; a change of the corrections
+restarts the estimate.
 
 Commands are published reliable keep-all (:data:`hyst_id.nodes.COMMAND_QOS`):
 a command the middleware refuses (a subscriber stalled for seconds) is
@@ -247,10 +250,6 @@ class Compensator(HystNode):
                 aug.limits(_limits(values))
             except InvalidParametersError as exc:
                 return f'{exc}; keeping the last limits and corrections'
-            if values['tracking.enabled'] and (aug.has_output_map or aug.has_schedule):
-                return ('tracking.enabled with an augment.* schedule or output map: the '
-                        "tracker's prediction is the bare model's, so it would correct "
-                        'the schedule twice; use one of them')
         if changed & _MODEL_KEYS and not augment_changed and getattr(self, '_comp', None) \
                 is not None and self._comp.augmentation.has_output_map:
             return ("the in-line output map (augment.poly_*) belongs to the diagnosis's own "
@@ -300,8 +299,10 @@ class Compensator(HystNode):
                                                         self._publish_status)
         source = self._source_hint or 'set_parameters'
         self._source_hint = ''
+        # the tracked gain and offset are what the corrections left: new ones, a new estimate
         if any(n.startswith('tracking.') for n in changed) or (
-                'channel' in changed and self._tracking.adaptive is not None):
+                self._tracking.adaptive is not None and ('channel' in changed
+                                                         or self._comp.augmentation != before[2])):
             self._tracking.configure(values, self._comp)
         if changed & _MODEL_KEYS:
             kind, model, unset = _model_state(values)

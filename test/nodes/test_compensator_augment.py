@@ -97,10 +97,22 @@ def test_limits_that_the_stops_leave_empty_are_refused_not_raised(ctx):
     assert (comp._comp.limits.min_command, comp._comp.limits.max_command) == (32.0, 38.0)
 
 
-def test_tracking_and_a_schedule_are_not_run_together(ctx):
+def test_tracking_runs_on_top_of_the_corrections_and_restarts_with_them(ctx):
     comp = _node(ctx, **{'augment.offset_rate_per_s': 0.01})
     result = comp.set_parameters_atomically([Parameter('tracking.enabled', value=True)])
-    assert not result.successful and 'correct the schedule twice' in result.reason
+    assert result.successful, result.reason
+    adaptive = comp._tracking.adaptive
+    assert adaptive.compensator is comp._comp          # the prediction is the augmented one
+    y = comp._comp.augmentation.reading(9.0, 100.0)
+    assert y == pytest.approx(9.0 + 0.01 * 100.0)
+    adaptive.tracker.gain = 0.9                        # an estimate on the old corrections
+    result = comp.set_parameters_atomically([Parameter('augment.offset_rate_per_s',
+                                                       value=0.02)])
+    assert result.successful, result.reason
+    restarted = comp._tracking.adaptive
+    assert restarted is not adaptive and restarted.tracker.gain == 1.0
+    result = comp.set_parameters_atomically([Parameter('max_command', value=19.0)])
+    assert result.successful and comp._tracking.adaptive is restarted   # same corrections
 
 
 def test_a_set_without_its_output_map_is_refused_while_one_is_in_force(ctx):
