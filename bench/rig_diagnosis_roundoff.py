@@ -27,8 +27,9 @@ instead (:func:`hyst_id.experiment.run.run_experiment` on the one channel,
 two GAASS seeds: (b) depends on the diagnosis only) and prints the verdict,
 the findings and what they became in the compensator, (a)'s and (b)'s %ε_c
 and the desired values' distance from the reference: how far (b)'s figure
-moves with the verdict. More lines say where (b) misses: its mean error
-against the reference per fifth of the reference level, the share of its
+moves with the verdict; and column (c), (b)'s compensator with tracking.
+More lines say where (b) and (c) miss: their mean error against the
+reference per fifth of the reference level, the share of (b)'s
 commands at the upper command limit (a level the plant cannot give), and, with an output
 map (``static_nonlinearity``), the share of the run's model targets past the
 travel the map was fitted on (``|z| > 1``, where it continues straight).
@@ -76,6 +77,12 @@ from hyst_id.diagnosis.export import compensator_set
 from hyst_id.experiment.run import run_experiment
 seen = {}
 plain = columns.adaptive_columns
+loop = columns.closed_loop_tracking
+def tracked(*a, **kw):
+    out = loop(*a, **kw)
+    seen['tracker'] = out[1].tracker
+    return out
+columns.closed_loop_tracking = tracked
 def kept(diagnosis, result, rig, t_s, *rest, desired_augmented=None, **kw):
     seen.update(diagnosis=diagnosis, t_s=t_s, desired=desired_augmented)
     return plain(diagnosis, result, rig, t_s, *rest, desired_augmented=desired_augmented, **kw)
@@ -85,8 +92,8 @@ res = run_experiment('params/paper_rig.yaml', seeds=2, modes=('gaass',), channel
 sc = res.scenarios['off']
 r = sc.channels[('gaass', %r)]
 a = r.adaptive
-print(a.verdict, [m for m, _ in a.applied], '(a) %%.3g (b) %%.3g' %% (
-      r.eps_c_percent, a.eps_c_augmented_percent),
+print(a.verdict, [m for m, _ in a.applied], '(a) %%.3g (b) %%.3g (c) %%.3g' %% (
+      r.eps_c_percent, a.eps_c_augmented_percent, a.eps_c_tracking_percent),
       'desired value vs reference (a) / (b) %%.3g / %%.3g' %% a.floor_percent, a.augmentation)
 ref = sc.reference.truth[{'position': 'position_clean', 'pressure': 'pressure_clean_pa',
                           'flow': 'flow_clean_g_s'}[%r]]
@@ -95,6 +102,13 @@ fifth = np.minimum((5 * np.argsort(np.argsort(ref))) // ref.size, 4)
 print('    (b) minus reference by fifth of the reference level, low to high (mean):',
       ' '.join(f'{err[fifth == k].mean():.3g}' for k in range(5)))
 top = a.command_augmented_ma >= res.config.command_limits_ma[1] - 1e-9
+err_c = a.w_tracking - ref
+print('    (c) minus reference by fifth of the reference level, low to high (mean):',
+      ' '.join(f'{err_c[fifth == k].mean():.3g}' for k in range(5)),
+      f'(tracked gain at the end {a.tracking_gain:.4g})')
+for e in seen['tracker'].events:
+    if e.reason.startswith('correction'):
+        print(f'    (c) at {e.t_s:.1f} s: {e.reason} (gain {e.gain:.3g}, offset {e.offset:.4g})')
 print('    (b) commands at the upper limit, per fifth of the level:',
       ' '.join(f'{np.mean(top[fifth == k]):.0%%}' for k in range(5)))
 _, aug, _ = compensator_set(seen['diagnosis'])

@@ -31,10 +31,12 @@ identification run and with no simulator truth:
     (:func:`~hyst_id.experiment.run.calibration_by_bic` with ``gain_law``; a
     static curve of degree 1-3 where the run shows one): the supply level the
     regulated reference holds.
-(c) **tracking**: the identified set in an
-    :class:`~hyst_id.compensation.tracking.AdaptiveCompensator` (gain and
-    offset by recursive least squares, forgetting ``forget_time_s``), closed
-    sample by sample around the rig simulator, as the node runs it.
+(c) **tracking**: (b)'s augmented compensator and desired value in an
+    :class:`~hyst_id.compensation.tracking.AdaptiveCompensator` (what the
+    schedules leave of the plant's gain and offset, by recursive least
+    squares, forgetting ``forget_time_s``; the prediction is the augmented
+    model's), closed sample by sample around the rig simulator, as the node
+    runs it. The sensor of the prediction is the identified chain's.
 """
 
 from __future__ import annotations
@@ -106,15 +108,18 @@ def diagnose_channel(recording: Any, settings: DiagnoseSettings) -> Any:
 
 def closed_loop_tracking(rig: RigParams, t_s: np.ndarray, desired: np.ndarray,
                          x: np.ndarray, sign: float, channel: str, seed: int | None,
-                         forget_time_s: float | None, limits: CommandLimits
+                         forget_time_s: float | None, limits: CommandLimits,
+                         compensator: Compensator | AugmentedCompensator | None = None
                          ) -> tuple[np.ndarray, AdaptiveCompensator | None]:
     """Readings of the rig compensated sample by sample, with tracking when ``forget_time_s``.
 
     ``x`` is the identified canonical chain (its sensor parameters feed the
-    tracker's prediction). Returns the readings and the adaptive compensator
-    (``None`` without tracking).
+    tracker's prediction); the compensator is its H⁻¹ unless ``compensator``
+    is given (column (c): (b)'s augmented one). Returns the readings and the
+    adaptive compensator (``None`` without tracking).
     """
-    comp = Compensator(InverseModel.from_vector(x, sign), limits, v0=limits.min_command)
+    comp = compensator if compensator is not None else Compensator(
+        InverseModel.from_vector(x, sign), limits, v0=limits.min_command)
     adaptive = None
     if forget_time_s is not None:
         sensor = tuple(np.asarray(x)[chain_spec(channel).sensor_slice])
@@ -172,9 +177,10 @@ def adaptive_columns(diagnosis: Any, result: Any, rig: RigParams, t_s: np.ndarra
     desired = result.desired if desired_augmented is None else desired_augmented
     command = AugmentedCompensator(model, aug, limits, v0=limits.min_command).run(desired, t_s)
     w_b = simulate_rig(rig, t_s, command, seed=noise_seed).measurement(ch)
-    w_c, adaptive = closed_loop_tracking(rig, t_s, result.desired, result.x_used,
-                                         result.ident.output_sign, ch, noise_seed,
-                                         forget_time_s, limits)
+    w_c, adaptive = closed_loop_tracking(
+        rig, t_s, desired, result.x_used, result.ident.output_sign, ch, noise_seed,
+        forget_time_s, limits,
+        compensator=AugmentedCompensator(model, aug, limits, v0=limits.min_command))
     return AdaptiveColumns(
         eps_c_augmented_percent=eps_c_percent(w_b, w_ud, offset),
         eps_c_tracking_percent=eps_c_percent(w_c, w_ud, offset), augmented_from=source,
