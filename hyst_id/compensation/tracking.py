@@ -32,7 +32,10 @@ forgetting estimator has on a steady drift (about ``forget_time_s`` times
 the drift rate without it: measured on the drifting-plant test, three times
 the late error).
 
-Acceptance: the correction is applied only while it predicts the recent
+Acceptance: the correction is applied only once the estimate has taken
+:data:`MIN_UPDATES` samples (before, it rests on too few: on the paper
+rig's compensation run, a sample each 0.5 s, a correction applied after 13
+samples held an offset of 8 kPa that was gone 8 samples later), only while it predicts the recent
 readings clearly better than the nominal model does (exponentially weighted
 a-priori squared error below :data:`ACCEPT_RATIO` x the nominal model's),
 and while the gain is inside its bounds (an estimate pinned at a bound is
@@ -60,11 +63,13 @@ from hyst_id.compensation.inverse import Compensator
 from hyst_id.errors import InvalidParametersError
 from hyst_id.models.sensors import first_order_coefficient, second_order_coefficients
 
-__all__ = ['ACCEPT_RATIO', 'AdaptiveCompensator', 'GainOffsetTracker', 'SensorPredictor',
-           'TrackerEvent']
+__all__ = ['ACCEPT_RATIO', 'AdaptiveCompensator', 'GainOffsetTracker', 'MIN_UPDATES',
+           'SensorPredictor', 'TrackerEvent']
 
 #: Recent squared error of the tracked model / the nominal model's below which it is used.
 ACCEPT_RATIO = 0.5
+#: Samples an estimate must have taken before its correction is applied.
+MIN_UPDATES = 40
 
 
 class SensorPredictor:
@@ -176,6 +181,7 @@ class GainOffsetTracker:
         self._t_prev: float | None = None
         self._clipped = False
         self._sse = np.zeros(2)       # weighted squared a-priori errors: nominal, tracked
+        self.n_updates = 0            # samples the estimate has taken (excited, free)
         self.applied = False
 
     @property
@@ -223,6 +229,7 @@ class GainOffsetTracker:
                                            f'{self.min_excitation:.3g} (no excitation)')
             return
         lam = math.exp(-dt / self.forget_time_s)
+        self.n_updates += 1
         # the trend's origin moves with time: re-express (offset, rate) at t_s
         self.offset = self.offset_at(t_s)
         self._t_ref = t_s
@@ -253,7 +260,8 @@ class GainOffsetTracker:
     def _accept(self, t_s: float) -> None:
         """Apply the correction only while it predicts clearly better and is not clipped."""
         ratio = self._sse[1] / max(self._sse[0], 1e-300)
-        applied = bool(ratio < ACCEPT_RATIO and not self._clipped)
+        young = self.n_updates < MIN_UPDATES
+        applied = bool(ratio < ACCEPT_RATIO and not self._clipped and not young)
         if applied != self.applied:
             why = ('gain at its bound' if self._clipped else
                    f'recent error of the tracked model {ratio:.2f} x that of the nominal one')
