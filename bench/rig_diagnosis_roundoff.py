@@ -20,7 +20,10 @@ experiment`` column (b) diagnoses) is diagnosed once per round-off probe
 bits as another CPU's sums would); each line prints the verdict, the
 findings, the final held-out %e_r, each finding's alternatives (tied or
 close calls) and the first round's drift blocks with their judged held-out
-%e_r. A verdict that changes between probes is a tie the data do not decide.
+%e_r; then the final held-out error over the noise floor and, per later
+round, how ``static_nonlinearity`` fitted there. A verdict that changes
+between probes is a tie the data do not decide, or a fit that lands in a
+different optimum.
 
 With ``--augmented`` each probe runs ``hyst-id experiment``'s column (b)
 instead (:func:`hyst_id.experiment.run.run_experiment` on the one channel,
@@ -68,6 +71,14 @@ first = {c['mechanism']: round(c['er_judged_percent'], 4)
 print(d.verdict, [f.mechanism for f in d.findings], round(d.final.er_holdout_percent, 4),
       [[f"{a['mechanism']} ({a.get('kind', 'tied')})" for a in f.alternatives]
        for f in d.findings], 'round 1 drift blocks (judged held-out %%e_r):', first)
+print('    final held-out %%.2f x the noise floor' %% (
+      d.final.er_holdout_percent / d.noise_floor_percent))
+for k, rnd in enumerate(d.to_dict()['tested'][1:], start=2):
+    for c in rnd['candidates']:
+        if c['mechanism'] == 'static_nonlinearity':
+            print(f"    round {k} static_nonlinearity: held-out %%e_r "
+                  f"{c['er_judged_percent']:.4g}, training {c['er_train_percent']:.4g}, "
+                  f"dBIC {c['delta_bic']:.0f}, {c['status']}")
 """
 
 AUGMENTED = """
