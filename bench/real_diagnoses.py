@@ -17,7 +17,9 @@
 The recordings are read as in ``bench/real_recordings.py`` (cylinder force
 against piston displacement; B(H) loops with the sample index as time) and
 diagnosed blind with the default settings. Printed per recording: the
-baseline's training and held-out %e_r, every finding with its block's
+baseline's training and held-out %e_r, the measured loop in words (its
+direction, half-width and rate signature, from the data alone:
+:mod:`hyst_id.diagnosis.measured_loop`), every finding with its block's
 parameters and the held-out %e_r after it, the final held-out %e_r over the
 noise floor, the rows the criteria judged on, the hold convention, the notes,
 and each finding's blocked cross-validation (time blocks better / worse).
@@ -69,6 +71,7 @@ def main() -> int:
         print(f'\n{rec.source} ({rec.n_samples} samples, {time.time() - t0:.0f} s): verdict '
               f'{d.verdict}; baseline %e_r train {d.baseline.er_train_percent:.3g} / held-out '
               f'{d.baseline.er_holdout_percent:.3g}; noise floor {d.noise_floor_percent:.3g}')
+        print(f'  {d.measured_loop.words(d.quantity, d.measurement_unit)}')
         for f in d.findings:
             cv = f.blocked_cv
             print(f'  {f.mechanism}: {_params(f)} (held-out {f.er_holdout_before_percent:.3g} '

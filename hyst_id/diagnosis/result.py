@@ -28,6 +28,7 @@ import numpy as np
 
 from hyst_id.diagnosis.blocked_cv import confirmed
 from hyst_id.diagnosis.locate import Localization
+from hyst_id.diagnosis.measured_loop import measured_loop, MeasuredLoop
 from hyst_id.diagnosis.select import Criteria, FitResult
 from hyst_id.io.jsonable import jsonable
 
@@ -183,6 +184,11 @@ class Diagnosis:
         return self.measurement_name or self.channel
 
     @property
+    def measured_loop(self) -> MeasuredLoop:
+        """The loop the whole record traces, from the data alone (:mod:`.measured_loop`)."""
+        return measured_loop(self.t_s, self.command, self.measurement)
+
+    @property
     def train_fraction(self) -> float:
         """Share of the duration used for training."""
         t = self.t_s
@@ -213,6 +219,7 @@ class Diagnosis:
             'final_residual': {'summary': self.final_localization.summary(
                 self.measurement_unit), 'white': self.final_localization.white,
                 'independent': self.final_localization.independent},
+            'measured_loop': self.measured_loop.to_dict(),
             'tested': self.rounds, 'notes': list(self.notes),
             'empirical': None if self.empirical is None else self.empirical.to_dict(),
         }
@@ -229,6 +236,7 @@ class Diagnosis:
                   'baseline_er_holdout_percent': f'{self.baseline.er_holdout_percent:.4g}',
                   'final_er_holdout_percent': f'{self.final.er_holdout_percent:.4g}',
                   'noise_floor_percent': f'{self.noise_floor_percent:.4g}',
+                  'measured_loop': self.measured_loop.direction,
                   'mechanisms': ','.join(f.mechanism for f in self.findings)}
         shaky = [f.mechanism for f in self.findings if not confirmed(f.blocked_cv)]
         if shaky:       # fitted on the split, not held up by blocked cross-validation

@@ -240,6 +240,9 @@ def test_json_document_has_the_issue_schema(delay_diagnosis, tmp_path):
                       'er_holdout_before_percent', 'er_holdout_after_percent'}
     assert set(doc['final']) >= {'mechanisms', 'er_train_percent', 'er_holdout_percent'}
     assert doc['final']['mechanisms'] == ['dead_time']
+    # the paper's loop lags the command: counter-clockwise, said from the data alone
+    assert doc['measured_loop']['direction'] == 'counter-clockwise'
+    assert 'the measured loop runs counter-clockwise' in delay_diagnosis.report()
     assert f['params']['delay_s']['unit'] == 's'
     assert f['compensation']['kind'] == 'in-line' and 'ahead' in f['compensation']['how']
     assert f['compensation']['correction'] == {

@@ -1,0 +1,251 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""The measured loop in words, from the data alone (before any model).
+
+Which way the loop runs says what kind of physics makes it, and a physicist
+reads that first. In the frame where the measurement rises with the command:
+
+* **counter-clockwise** (lower while the command rises, higher while it
+  falls): the measurement *lags* the command, as a play, magnetic domains,
+  a piezo stack or any lagging dynamics make it (the paper's model makes
+  these loops);
+* **clockwise** (higher while the command rises): the measurement *leads*
+  the motion, as a force against the motion does (friction in a seal,
+  a damper): the cylinder's force against its displacement;
+* **thin**: no loop to speak of (half-width below :data:`THIN_SHARE` of
+  the measurement's span).
+
+The direction of each sample is its sweep's (between the command's
+reversals beyond 2 % of its span, so noise on a measured command does not
+flip it). The half-width is measured level by level: the command's range is
+cut into bins of equal counts, and in each the mean measurement while
+rising is set against that while falling; half their difference, averaged
+over the bins (weighted by the passes of the rarer direction), is the
+loop's half-width, signed by the direction (a sum of signed area would be
+spoiled by loops that do not close, as in a record of loops of growing
+amplitude one after another). The sweeps split at their median rate (each
+direction at its own, as a drive may move out and back at different
+speeds) give
+the half-width of the slow and of the fast sweeps: the same for a loop
+that does not depend on the rate (a friction band, a play), larger at the
+fast sweeps for viscous drag or lagging dynamics. The two are compared only
+when the slow and the fast sweeps span about the same range (a larger
+sweep makes a wider loop at any rate) and their rates differ by
+:data:`RATE_SPREAD`. All are measured signatures, not
+fits; the diagnosis's blocks say the rest.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from hyst_id.signals.reversals import reversal_indices
+
+__all__ = ['MeasuredLoop', 'measured_loop', 'RATE_GROWTH', 'RATE_SPREAD', 'THIN_SHARE']
+
+#: Fast-sweep over slow-sweep half-width above which the loop is said to grow with the rate.
+RATE_GROWTH = 1.3
+#: Half-width, as a share of the measurement's span, below which the loop is thin.
+THIN_SHARE = 0.005
+#: Slow and fast sweeps are compared only when their median spans are within this ratio.
+SPAN_MATCH = 1.25
+#: Fast sweeps' median rate over the slow sweeps' needed to compare their loops.
+RATE_SPREAD = 1.5
+#: Levels (bins of equal counts) the half-width is measured at.
+N_LEVELS = 12
+#: Passes of each direction in a level needed to count it.
+MIN_PASSES = 3
+
+
+@dataclass(frozen=True)
+class MeasuredLoop:
+    """What the measured loop looks like.
+
+    Attributes
+    ----------
+    direction : str
+        ``'counter-clockwise'``, ``'clockwise'`` or ``'thin'``, in the frame
+        where the measurement rises with the command.
+    rises_with_command : bool
+        Whether the measurement rises with the command (else the frame is mirrored).
+    half_width : float
+        Mean half-gap between the rising and the falling passes over the
+        command's levels, in measurement units, positive for the loop's own
+        direction (NaN when the command does not sweep both ways).
+    half_width_share : float
+        ``half_width`` over the measurement's span.
+    half_width_slow, half_width_fast : float
+        The same over the sweeps slower and faster than their median rate.
+    rate_slow, rate_fast : float
+        Median rate of those sweeps (command units per second).
+    span_slow, span_fast : float
+        Median span of those sweeps (command units).
+    """
+
+    direction: str
+    rises_with_command: bool
+    half_width: float
+    half_width_share: float
+    half_width_slow: float
+    half_width_fast: float
+    rate_slow: float
+    rate_fast: float
+    span_slow: float
+    span_fast: float
+
+    @property
+    def rates_comparable(self) -> bool:
+        """Whether slow and fast sweeps span about the same range at rates that differ."""
+        vals = (self.half_width_slow, self.half_width_fast, self.span_slow, self.span_fast)
+        if not all(np.isfinite(vals)) or min(self.span_slow, self.span_fast) <= 0.0:
+            return False
+        return (max(self.span_slow, self.span_fast) <= SPAN_MATCH * min(self.span_slow,
+                                                                        self.span_fast)
+                and self.rate_fast >= RATE_SPREAD * self.rate_slow)
+
+    @property
+    def grows_with_rate(self) -> bool | None:
+        """Whether the fast sweeps' loop is wider by :data:`RATE_GROWTH` (None: not compared)."""
+        if self.direction == 'thin' or not self.rates_comparable or self.half_width_slow <= 0:
+            return None
+        return bool(self.half_width_fast > RATE_GROWTH * self.half_width_slow)
+
+    def to_dict(self) -> dict:
+        """The ``--json`` entry."""
+        return {**asdict(self), 'rates_comparable': self.rates_comparable,
+                'grows_with_rate': self.grows_with_rate}
+
+    def words(self, quantity: str = 'measurement', unit: str = '') -> str:
+        """One sentence for the report."""
+        u = f' {unit}' if unit else ''
+        if not np.isfinite(self.half_width):
+            return 'the command does not sweep both ways, so the record traces no loop'
+        width = f'half-width {abs(self.half_width):.3g}{u}, {100 * self.half_width_share:.1f} %'
+        if self.direction == 'thin':
+            return (f'the measured loop is thin ({width} of the span): the {quantity} is '
+                    'nearly a single-valued function of the command')
+        frame = ('' if self.rises_with_command else
+                 f' (of -{quantity}: it falls as the command rises)')
+        if self.direction == 'counter-clockwise':
+            kind = (f'counter-clockwise{frame}: the {quantity} lags the command (lower while it '
+                    'rises), as a play, magnetic domains, a piezo stack or lagging dynamics '
+                    'make it')
+        else:
+            kind = (f'clockwise{frame}: the {quantity} leads the motion (higher while the command '
+                    'rises), as a force against the motion does (friction in a seal, a damper); '
+                    "the paper's loop runs the other way")
+        out = f'the measured loop runs {kind} ({width} of the span)'
+        if np.isfinite(self.half_width_slow) and np.isfinite(self.half_width_fast):
+            out += (f'; {self.half_width_slow:.3g}{u} over the slow sweeps '
+                    f'({self.rate_slow:.3g}/s, spanning {self.span_slow:.3g}), '
+                    f'{self.half_width_fast:.3g}{u} over the fast ({self.rate_fast:.3g}/s, '
+                    f'{self.span_fast:.3g})')
+            grows = self.grows_with_rate
+            if grows is None:
+                out += ': not compared, the sweeps differ in span or their rates are too alike'
+            elif grows:
+                out += ': the loop grows with the rate (viscous drag or lagging dynamics)'
+            else:
+                out += ': rate independent (a band or a play)'
+        return out
+
+
+def _sweeps(v: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per sample: its sweep's direction (+1, -1, 0), mean rate and span."""
+    idx, dirs = reversal_indices(v)
+    n = v.size
+    direction = np.zeros(n)
+    rate = np.full(n, np.nan)
+    span = np.full(n, np.nan)
+    if idx.size == 0:
+        return direction, rate, span
+    edges = [0] + [int(i) for i in idx] + [n - 1]
+    signs = [-int(dirs[0])] + [int(d) for d in dirs]
+    for k, d in enumerate(signs):
+        a, b = edges[k], edges[k + 1]
+        if b <= a:
+            continue
+        direction[a + 1:b + 1] = d
+        dv = abs(float(v[b] - v[a]))
+        dt = float(t[b] - t[a])
+        span[a + 1:b + 1] = dv
+        rate[a + 1:b + 1] = dv / dt if dt > 0 else np.nan
+    return direction, rate, span
+
+
+def _half_gap(v: np.ndarray, y: np.ndarray, direction: np.ndarray, edges: np.ndarray,
+              keep: np.ndarray) -> float:
+    """Weighted mean over the levels of half (mean rising - mean falling)."""
+    level = np.clip(np.searchsorted(edges, v, side='right') - 1, 0, edges.size - 2)
+    num = den = 0.0
+    for b in range(edges.size - 1):
+        at = keep & (level == b)
+        up, down = at & (direction > 0), at & (direction < 0)
+        w = min(int(np.count_nonzero(up)), int(np.count_nonzero(down)))
+        if w >= MIN_PASSES:
+            num += w * 0.5 * float(np.mean(y[up]) - np.mean(y[down]))
+            den += w
+    return num / den if den > 0 else float('nan')
+
+
+def measured_loop(t_s: np.ndarray, command: np.ndarray, measurement: np.ndarray
+                  ) -> MeasuredLoop:
+    """Describe the loop a recording traces (see the module docstring).
+
+    Parameters
+    ----------
+    t_s, command, measurement : numpy.ndarray
+        The recording (finite, time increasing).
+
+    Returns
+    -------
+    MeasuredLoop
+        Direction and half-widths (positive in the loop's own direction).
+    """
+    t = np.asarray(t_s, dtype=np.float64)
+    v = np.asarray(command, dtype=np.float64)
+    y = np.asarray(measurement, dtype=np.float64)
+    rises = float(np.mean((v - v.mean()) * (y - y.mean()))) >= 0.0
+    ys = y if rises else -y
+    direction, rate, span = _sweeps(v, t)
+    moving = direction != 0
+    nan = float('nan')
+    if not np.any(direction > 0) or not np.any(direction < 0):
+        return MeasuredLoop('thin', bool(rises), nan, nan, nan, nan, nan, nan, nan, nan)
+    edges = np.unique(np.quantile(v[moving], np.linspace(0.0, 1.0, N_LEVELS + 1)))
+    if edges.size < 2:
+        return MeasuredLoop('thin', bool(rises), nan, nan, nan, nan, nan, nan, nan, nan)
+    gap = _half_gap(v, ys, direction, edges, moving)
+    y_span = float(np.ptp(y))
+    share = abs(gap) / y_span if y_span > 0 and np.isfinite(gap) else nan
+    kind = ('thin' if not share >= THIN_SHARE else
+            'clockwise' if gap > 0 else 'counter-clockwise')
+    sign = 1.0 if kind == 'clockwise' else -1.0   # the loop's own direction
+    slow = np.zeros(v.size, dtype=bool)
+    for d in (-1.0, 1.0):   # each direction at its own median (strokes out and in differ)
+        this = direction == d
+        slow |= this & (rate <= float(np.nanmedian(rate[this])))
+    fast = moving & ~slow
+    w_slow = sign * _half_gap(v, ys, direction, edges, slow)
+    w_fast = sign * _half_gap(v, ys, direction, edges, fast)
+
+    def med(x: np.ndarray) -> float:
+        return float(np.median(x)) if x.size else nan
+
+    return MeasuredLoop(kind, bool(rises), float(sign * gap), float(share), float(w_slow),
+                        float(w_fast), med(rate[slow]), med(rate[fast]), med(span[slow]),
+                        med(span[fast]))
