@@ -71,7 +71,8 @@ def main() -> int:
         print(f'\n{rec.source} ({rec.n_samples} samples, {time.time() - t0:.0f} s): verdict '
               f'{d.verdict}; baseline %e_r train {d.baseline.er_train_percent:.3g} / held-out '
               f'{d.baseline.er_holdout_percent:.3g}; noise floor {d.noise_floor_percent:.3g}')
-        print(f'  {d.measured_loop.words(d.quantity, d.measurement_unit)}')
+        print('  ' + d.measured_loop.words(d.measurement_name or 'measurement',
+                                           d.measurement_unit))
         for f in d.findings:
             cv = f.blocked_cv
             print(f'  {f.mechanism}: {_params(f)} (held-out {f.er_holdout_before_percent:.3g} '

@@ -205,7 +205,8 @@ def format_diagnosis(d: Any) -> str:
                  f'{_fmt(d.baseline.er_holdout_percent)}; noise floor '
                  f'{_fmt(d.noise_floor_percent)} held-out / {_fmt(d.noise_floor_train_percent)} '
                  f'train (noise std {d.noise_std:.3g}{" " + unit if unit else ""})')
-    lines.append(f'{d.measured_loop.words(d.quantity, unit)} (from the data alone)')
+    loop_words = d.measured_loop.words(d.measurement_name or 'measurement', unit)
+    lines.append(f'{loop_words} (from the data alone)')
     lines += ['', 'where the baseline departs from the measurement:']
     lines += [f'  - {s}' for s in d.localization.summary(unit)]
     lines.append('')
