@@ -28,6 +28,7 @@ Usage (from the repository root; a few minutes in all)::
 
     python bench/real_diagnoses.py [--data ../shared/data] [--only Circle_1bar]
     python bench/real_diagnoses.py --figures docs/figures    # the docs' figures too
+    python bench/real_diagnoses.py --only pneumatic --cli-reader --workers 2   # as the CLI
 """
 
 from __future__ import annotations
@@ -43,11 +44,12 @@ sys.path.insert(0, str(ROOT))
 
 from real_recordings import load_all  # noqa: E402, I100
 
-from hyst_id.diagnosis import diagnose  # noqa: E402, I100
+from hyst_id.diagnosis import diagnose, DiagnoseSettings  # noqa: E402, I100
 from hyst_id.diagnosis.blocked_cv import confirmed  # noqa: E402
 from hyst_id.diagnosis.export import compensator_set  # noqa: E402
 from hyst_id.diagnosis.report import plot_diagnosis  # noqa: E402
 from hyst_id.errors import HystIdError  # noqa: E402
+from hyst_id.io.csv_reader import read_csv  # noqa: E402
 
 
 def _params(finding) -> str:
@@ -61,12 +63,23 @@ def main() -> int:
     ap.add_argument('--only', default='', help='substring of the recordings to run')
     ap.add_argument('--figures', metavar='DIR',
                     help="write each diagnosis's figure as DIR/real_<file>.png (docs/figures)")
+    ap.add_argument('--workers', type=int, default=1,
+                    help="DiagnoseSettings.workers (the CLI's --workers)")
+    ap.add_argument('--cli-reader', action='store_true',
+                    help="read the cylinder's files as hyst-id diagnose FILE --columns 0,4,6 "
+                         '--time-scale 0.001 does (t x 0.001 rather than t / 1000: the last bit '
+                         'of some stamps differs)')
     args = ap.parse_args()
-    for rec in load_all(Path(args.data)):
+    recs = load_all(Path(args.data))
+    if args.cli_reader:
+        recs = [read_csv(Path(args.data) / r.source, 'position', columns=(0, 4, 6),
+                         time_scale=0.001, command_unit='mm', measurement_unit='N')
+                if r.source.startswith('pneumatic') else r for r in recs]
+    for rec in recs:
         if args.only and args.only not in rec.source:
             continue
         t0 = time.time()
-        d = diagnose(rec)
+        d = diagnose(rec, settings=DiagnoseSettings(workers=args.workers))
         j = d.extra['judged_holdout']
         print(f'\n{rec.source} ({rec.n_samples} samples, {time.time() - t0:.0f} s): verdict '
               f'{d.verdict}; baseline %e_r train {d.baseline.er_train_percent:.3g} / held-out '
