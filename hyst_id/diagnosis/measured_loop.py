@@ -15,7 +15,10 @@
 """The measured loop in words, from the data alone (before any model).
 
 Which way the loop runs says what kind of physics makes it, and a physicist
-reads that first. In the frame where the measurement rises with the command:
+reads that first. In the frame where the loop's mid-line rises with the
+command (the measurement is read negated when its mid-line falls with the
+command by more than the loop's full width; a flat band, whose mid-line
+does not decide, is read as recorded):
 
 * **counter-clockwise** (lower while the command rises, higher while it
   falls): the measurement *lags* the command, as a play, magnetic domains,
@@ -29,22 +32,26 @@ reads that first. In the frame where the measurement rises with the command:
 
 The direction of each sample is its sweep's (between the command's
 reversals beyond 2 % of its span, so noise on a measured command does not
-flip it). The half-width is measured level by level: the command's range is
-cut into bins of equal counts, and in each the mean measurement while
-rising is set against that while falling; half their difference, averaged
-over the bins (weighted by the passes of the rarer direction), is the
-loop's half-width, signed by the direction (a sum of signed area would be
-spoiled by loops that do not close, as in a record of loops of growing
-amplitude one after another). The sweeps split at their median rate (each
-direction at its own, as a drive may move out and back at different
-speeds) give
-the half-width of the slow and of the fast sweeps: the same for a loop
-that does not depend on the rate (a friction band, a play), larger at the
-fast sweeps for viscous drag or lagging dynamics. The two are compared only
-when the slow and the fast sweeps span about the same range (a larger
-sweep makes a wider loop at any rate) and their rates differ by
-:data:`RATE_SPREAD`. All are measured signatures, not
-fits; the diagnosis's blocks say the rest.
+flip it); a hold at a reversal, before the command has left the extreme by
+more than its noise, keeps the direction that brought it there, and a
+hold inside a sweep (a staircase) the sweep's. The half-width is measured
+level by level: the command's range is cut into :data:`N_LEVELS` bins of
+equal counts of distinct command values (so a long hold does not swallow
+the bins), and in each the rising samples are set against the falling ones
+at the same command (one straight line through the bin for both, shifted
+apart by the gap, so where each direction's samples fall inside the bin
+does not count). Half the gap, averaged over the bins (weighted by the
+samples of the rarer direction), is the loop's half-width, signed by the
+direction (a sum of signed area would be spoiled by loops that do not
+close, as in a record of loops of growing amplitude one after another).
+The samples split at their sweeps' median rate (each direction at its own,
+as a drive may move out and back at different speeds) give the half-width
+of the slow and of the fast sweeps: the same for a loop that does not
+depend on the rate (a friction band, a play), larger at the fast sweeps
+for viscous drag or lagging dynamics. The two are compared only when the
+slow and the fast sweeps span about the same range (a larger sweep makes a
+wider loop at any rate) and their rates differ by :data:`RATE_SPREAD`. All
+are measured signatures, not fits; the diagnosis's blocks say the rest.
 """
 
 from __future__ import annotations
@@ -53,9 +60,11 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from hyst_id.errors import RecordingError
 from hyst_id.signals.reversals import reversal_indices
 
-__all__ = ['MeasuredLoop', 'measured_loop', 'RATE_GROWTH', 'RATE_SPREAD', 'THIN_SHARE']
+__all__ = ['MeasuredLoop', 'measured_loop', 'MIN_SAMPLES', 'N_LEVELS', 'RATE_GROWTH',
+           'RATE_SPREAD', 'SPAN_MATCH', 'THIN_SHARE']
 
 #: Fast-sweep over slow-sweep half-width above which the loop is said to grow with the rate.
 RATE_GROWTH = 1.3
@@ -65,10 +74,16 @@ THIN_SHARE = 0.005
 SPAN_MATCH = 1.25
 #: Fast sweeps' median rate over the slow sweeps' needed to compare their loops.
 RATE_SPREAD = 1.5
-#: Levels (bins of equal counts) the half-width is measured at.
+#: Levels (bins of equal counts of distinct command values) the half-width is measured at.
 N_LEVELS = 12
-#: Passes of each direction in a level needed to count it.
-MIN_PASSES = 3
+#: Samples of each direction in a level needed to count it.
+MIN_SAMPLES = 3
+#: A hold at a reversal lasts while the command stays within this many noise sigmas.
+HOLD_SIGMAS = 8.0
+
+NO_SWEEP = 'the command does not sweep both ways, so the record traces no loop'
+FEW_SAMPLES = ('too few samples of each direction at the same command levels to measure '
+               'a loop')
 
 
 @dataclass(frozen=True)
@@ -79,21 +94,27 @@ class MeasuredLoop:
     ----------
     direction : str
         ``'counter-clockwise'``, ``'clockwise'`` or ``'thin'``, in the frame
-        where the measurement rises with the command.
+        where the loop's mid-line rises with the command.
     rises_with_command : bool
-        Whether the measurement rises with the command (else the frame is mirrored).
+        False when the measurement is read negated (its mid-line falls with
+        the command by more than the loop's full width); True otherwise,
+        also for a flat band.
     half_width : float
-        Mean half-gap between the rising and the falling passes over the
-        command's levels, in measurement units, positive for the loop's own
-        direction (NaN when the command does not sweep both ways).
+        Mean half-gap between the rising and the falling samples at the
+        same command, over the command's levels, in measurement units;
+        positive for the loop's own direction (a thin loop's is signed as
+        a counter-clockwise one's); NaN when no loop could be measured
+        (``reason`` says why).
     half_width_share : float
-        ``half_width`` over the measurement's span.
+        ``|half_width|`` over the measurement's span.
     half_width_slow, half_width_fast : float
         The same over the sweeps slower and faster than their median rate.
     rate_slow, rate_fast : float
         Median rate of those sweeps (command units per second).
     span_slow, span_fast : float
         Median span of those sweeps (command units).
+    reason : str
+        Why no loop was measured (empty when one was).
     """
 
     direction: str
@@ -106,11 +127,13 @@ class MeasuredLoop:
     rate_fast: float
     span_slow: float
     span_fast: float
+    reason: str = ''
 
     @property
     def rates_comparable(self) -> bool:
         """Whether slow and fast sweeps span about the same range at rates that differ."""
-        vals = (self.half_width_slow, self.half_width_fast, self.span_slow, self.span_fast)
+        vals = (self.half_width_slow, self.half_width_fast, self.span_slow, self.span_fast,
+                self.rate_slow, self.rate_fast)
         if not all(np.isfinite(vals)) or min(self.span_slow, self.span_fast) <= 0.0:
             return False
         return (max(self.span_slow, self.span_fast) <= SPAN_MATCH * min(self.span_slow,
@@ -133,19 +156,20 @@ class MeasuredLoop:
         """One sentence for the report."""
         u = f' {unit}' if unit else ''
         if not np.isfinite(self.half_width):
-            return 'the command does not sweep both ways, so the record traces no loop'
+            return self.reason or NO_SWEEP
         width = f'half-width {abs(self.half_width):.3g}{u}, {100 * self.half_width_share:.1f} %'
         if self.direction == 'thin':
             return (f'the measured loop is thin ({width} of the span): the {quantity} is '
                     'nearly a single-valued function of the command')
+        q = quantity if self.rises_with_command else f'-{quantity}'
         frame = ('' if self.rises_with_command else
-                 f' (of -{quantity}: it falls as the command rises)')
+                 f' (read as -{quantity}: the {quantity} falls as the command rises)')
         if self.direction == 'counter-clockwise':
-            kind = (f'counter-clockwise{frame}: the {quantity} lags the command (lower while it '
+            kind = (f'counter-clockwise{frame}: the {q} lags the command (lower while it '
                     'rises), as a play, magnetic domains, a piezo stack or lagging dynamics '
                     'make it')
         else:
-            kind = (f'clockwise{frame}: the {quantity} leads the motion (higher while the command '
+            kind = (f'clockwise{frame}: the {q} leads the motion (higher while the command '
                     'rises), as a force against the motion does (friction in a seal, a damper); '
                     "the paper's loop runs the other way")
         out = f'the measured loop runs {kind} ({width} of the span)'
@@ -164,6 +188,13 @@ class MeasuredLoop:
         return out
 
 
+def _noise_sigma(v: np.ndarray) -> float:
+    """Robust sigma of white noise on the command (from its second differences)."""
+    if v.size < 3:
+        return 0.0
+    return float(np.median(np.abs(np.diff(v, 2)))) / (0.6745 * np.sqrt(6.0))
+
+
 def _sweeps(v: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Per sample: its sweep's direction (+1, -1, 0), mean rate and span."""
     idx, dirs = reversal_indices(v)
@@ -175,11 +206,16 @@ def _sweeps(v: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.nd
         return direction, rate, span
     edges = [0] + [int(i) for i in idx] + [n - 1]
     signs = [-int(dirs[0])] + [int(d) for d in dirs]
+    hold_tol = max(HOLD_SIGMAS * _noise_sigma(v), 1e-12 * float(np.ptp(v)))
     for k, d in enumerate(signs):
         a, b = edges[k], edges[k + 1]
         if b <= a:
             continue
         direction[a + 1:b + 1] = d
+        if k > 0:   # a hold at the reversal keeps the direction that brought it there
+            left = np.flatnonzero(d * (v[a + 1:b + 1] - v[a]) > hold_tol)
+            stop = a + 1 + (int(left[0]) if left.size else b - a)
+            direction[a + 1:stop] = signs[k - 1]
         dv = abs(float(v[b] - v[a]))
         dt = float(t[b] - t[a])
         span[a + 1:b + 1] = dv
@@ -187,19 +223,51 @@ def _sweeps(v: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.nd
     return direction, rate, span
 
 
-def _half_gap(v: np.ndarray, y: np.ndarray, direction: np.ndarray, edges: np.ndarray,
-              keep: np.ndarray) -> float:
-    """Weighted mean over the levels of half (mean rising - mean falling)."""
+def _levels(v: np.ndarray, y: np.ndarray, direction: np.ndarray, edges: np.ndarray,
+            keep: np.ndarray) -> list[tuple[float, float, float, float]]:
+    """Per level with both directions: (weight, mean command, rising and falling value).
+
+    The two values are those of one straight line through the level's
+    samples, shifted apart for the two directions, at the level's mean
+    command (so where each direction's samples lie inside the level does
+    not count).
+    """
     level = np.clip(np.searchsorted(edges, v, side='right') - 1, 0, edges.size - 2)
-    num = den = 0.0
+    out = []
     for b in range(edges.size - 1):
         at = keep & (level == b)
         up, down = at & (direction > 0), at & (direction < 0)
         w = min(int(np.count_nonzero(up)), int(np.count_nonzero(down)))
-        if w >= MIN_PASSES:
-            num += w * 0.5 * float(np.mean(y[up]) - np.mean(y[down]))
-            den += w
-    return num / den if den > 0 else float('nan')
+        if w < MIN_SAMPLES:
+            continue
+        vu, vd, yu, yd = v[up], v[down], y[up], y[down]
+        sxx = float(np.sum((vu - vu.mean()) ** 2) + np.sum((vd - vd.mean()) ** 2))
+        sxy = float(np.sum((vu - vu.mean()) * (yu - yu.mean()))
+                    + np.sum((vd - vd.mean()) * (yd - yd.mean())))
+        slope = sxy / sxx if sxx > 0 else 0.0
+        vm = float(np.mean(v[up | down]))
+        out.append((float(w), vm, float(yu.mean() + slope * (vm - vu.mean())),
+                    float(yd.mean() + slope * (vm - vd.mean()))))
+    return out
+
+
+def _half_gap(levels: list[tuple[float, float, float, float]]) -> float:
+    """Weighted mean over the levels of half (rising - falling)."""
+    den = sum(w for w, *_ in levels)
+    if den <= 0:
+        return float('nan')
+    return sum(w * 0.5 * (up - down) for w, _, up, down in levels) / den
+
+
+def _midline_rise(levels: list[tuple[float, float, float, float]]) -> float:
+    """How much the loop's mid-line rises over the levels (a weighted straight line)."""
+    if len(levels) < 2:
+        return 0.0
+    w, vm, up, down = (np.array(x) for x in zip(*levels))
+    if np.ptp(vm) <= 0:
+        return 0.0
+    slope = np.polyfit(vm, 0.5 * (up + down), 1, w=np.sqrt(w))[0]
+    return float(slope * np.ptp(vm))
 
 
 def measured_loop(t_s: np.ndarray, command: np.ndarray, measurement: np.ndarray
@@ -215,35 +283,49 @@ def measured_loop(t_s: np.ndarray, command: np.ndarray, measurement: np.ndarray
     -------
     MeasuredLoop
         Direction and half-widths (positive in the loop's own direction).
+
+    Raises
+    ------
+    RecordingError
+        When the arrays differ in length or hold a NaN or an infinity.
     """
     t = np.asarray(t_s, dtype=np.float64)
     v = np.asarray(command, dtype=np.float64)
     y = np.asarray(measurement, dtype=np.float64)
-    rises = float(np.mean((v - v.mean()) * (y - y.mean()))) >= 0.0
-    ys = y if rises else -y
+    if not t.shape == v.shape == y.shape or t.ndim != 1:
+        raise RecordingError(f'measured loop: time, command and measurement differ in shape '
+                             f'({t.shape}, {v.shape}, {y.shape})')
+    if not (np.all(np.isfinite(t)) and np.all(np.isfinite(v)) and np.all(np.isfinite(y))):
+        raise RecordingError('measured loop: the recording holds a NaN or an infinity')
     direction, rate, span = _sweeps(v, t)
     moving = direction != 0
     nan = float('nan')
     if not np.any(direction > 0) or not np.any(direction < 0):
-        return MeasuredLoop('thin', bool(rises), nan, nan, nan, nan, nan, nan, nan, nan)
-    edges = np.unique(np.quantile(v[moving], np.linspace(0.0, 1.0, N_LEVELS + 1)))
-    if edges.size < 2:
-        return MeasuredLoop('thin', bool(rises), nan, nan, nan, nan, nan, nan, nan, nan)
-    gap = _half_gap(v, ys, direction, edges, moving)
+        return MeasuredLoop('thin', True, nan, nan, nan, nan, nan, nan, nan, nan, NO_SWEEP)
+    edges = np.unique(np.quantile(np.unique(v[moving]), np.linspace(0.0, 1.0, N_LEVELS + 1)))
+    levels = _levels(v, y, direction, edges, moving) if edges.size >= 2 else []
+    raw_gap = _half_gap(levels)
+    if not np.isfinite(raw_gap):
+        return MeasuredLoop('thin', True, nan, nan, nan, nan, nan, nan, nan, nan, FEW_SAMPLES)
+    rises = not _midline_rise(levels) < -2.0 * abs(raw_gap)
+    ys = y if rises else -y
+    gap = raw_gap if rises else -raw_gap
     y_span = float(np.ptp(y))
-    share = abs(gap) / y_span if y_span > 0 and np.isfinite(gap) else nan
+    share = abs(gap) / y_span if y_span > 0 else 0.0
     kind = ('thin' if not share >= THIN_SHARE else
             'clockwise' if gap > 0 else 'counter-clockwise')
     sign = 1.0 if kind == 'clockwise' else -1.0   # the loop's own direction
     slow = np.zeros(v.size, dtype=bool)
     for d in (-1.0, 1.0):   # each direction at its own median (strokes out and in differ)
-        this = direction == d
-        slow |= this & (rate <= float(np.nanmedian(rate[this])))
+        this = (direction == d) & np.isfinite(rate)
+        if np.any(this):
+            slow |= this & (rate <= float(np.median(rate[this])))
     fast = moving & ~slow
-    w_slow = sign * _half_gap(v, ys, direction, edges, slow)
-    w_fast = sign * _half_gap(v, ys, direction, edges, fast)
+    w_slow = sign * _half_gap(_levels(v, ys, direction, edges, slow))
+    w_fast = sign * _half_gap(_levels(v, ys, direction, edges, fast))
 
     def med(x: np.ndarray) -> float:
+        x = x[np.isfinite(x)]
         return float(np.median(x)) if x.size else nan
 
     return MeasuredLoop(kind, bool(rises), float(sign * gap), float(share), float(w_slow),
