@@ -22,7 +22,13 @@ direction, half-width and slow/fast sweeps, and its words. Where the two
 disagree, loops that do not close (the B(H) records' loops of growing
 amplitude) have spoiled the signed area. A second or so in all.
 
-Usage: ``python bench/measured_loops.py [--data ../shared/data]``
+With ``--spreads`` it prints instead the ranges over seeds 0-29 that
+``test/diagnosis/test_measured_loop.py``'s bounds come from: the half-width
+of a Dahl friction force over its size, and of the paper's loop (reference
+simulator) as a share of the span, under a multisine and under a staircase of
+held steps (a few seconds).
+
+Usage: ``python bench/measured_loops.py [--data ../shared/data] [--spreads]``
 """
 
 from __future__ import annotations
@@ -34,6 +40,8 @@ import sys
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / 'bench'))
+sys.path.insert(0, str(ROOT / 'test'))
+sys.path.insert(0, str(ROOT / 'test' / 'diagnosis'))
 sys.path.insert(0, str(ROOT))
 
 from real_recordings import load_all  # noqa: E402, I100
@@ -42,11 +50,57 @@ from hyst_id.diagnosis.measured_loop import measured_loop  # noqa: E402, I100
 from hyst_id.identification.loop import loop_orientation  # noqa: E402
 
 
+def spreads(seeds: range = range(30)) -> None:
+    """Print the ranges the test's bounds come from (the test's own generators)."""
+    from friction_reference import euler_dahl
+    import numpy as np
+    from reference_sim import backlash, hysteresis
+    from test_measured_loop import _excitation
+
+    def chain(v):
+        return backlash(hysteresis(v, 1.01, 1.05, 0.10, 0.15, -0.25, 0.50, 14.0, 7.0), 1.0,
+                        -0.15, 0.15)
+
+    friction, paper, steps = [], [], []
+    for seed in seeds:
+        rng = np.random.default_rng(seed)
+        t, v = _excitation(rng)
+        force = rng.uniform(0.05, 0.4) * np.ptp(v)
+        y = 2.0 * v + force * euler_dahl(v, 0.01 * np.ptp(v), substeps=50)
+        loop = measured_loop(t, v, y + rng.normal(0.0, 0.005 * np.ptp(y), t.size))
+        friction.append((loop.direction, loop.half_width / force))
+        rng = np.random.default_rng(seed)
+        t, v = _excitation(rng)
+        gain = rng.choice([-1.0, 1.0]) * rng.uniform(0.5, 50.0)
+        y = gain * chain(v) + rng.uniform(-10, 10)
+        loop = measured_loop(t, v, y + rng.normal(0.0, 0.005 * np.ptp(y), t.size))
+        paper.append((loop.direction, loop.half_width_share))
+        rng = np.random.default_rng(seed)
+        v = np.repeat(rng.uniform(6.5, 11.5, 60), 50)
+        gain = rng.choice([-1.0, 1.0]) * rng.uniform(0.5, 50.0)
+        x = chain(v)
+        y = gain * x + rng.normal(0.0, 0.005 * abs(gain) * np.ptp(x), v.size)
+        loop = measured_loop(np.arange(v.size) * 0.02, v, y)
+        steps.append((loop.direction, loop.half_width_share))
+    for name, rows, what in (('Dahl friction (multisine)', friction, 'of the force'),
+                             ("the paper's loop (multisine)", paper, 'of the span'),
+                             ("the paper's loop (staircase)", steps, 'of the span')):
+        dirs = sorted({d for d, _ in rows})
+        vals = [x for _, x in rows]
+        print(f'{name}, seeds {seeds.start}-{seeds.stop - 1}: direction {", ".join(dirs)}; '
+              f'half-width {min(vals):.3g}-{max(vals):.3g} {what}')
+
+
 def main() -> int:
     """Print each recording's loop."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument('--data', default=str(ROOT.parent / 'shared' / 'data'))
+    ap.add_argument('--spreads', action='store_true',
+                    help="print the seeds' ranges the test's bounds come from")
     args = ap.parse_args()
+    if args.spreads:
+        spreads()
+        return 0
     for rec in load_all(Path(args.data)):
         loop = measured_loop(rec.t_s, rec.command, rec.measurement)
         y = rec.measurement if loop.rises_with_command else -rec.measurement

@@ -73,7 +73,7 @@ def test_the_papers_loop_runs_counter_clockwise_in_either_sign(seed):
     loop = measured_loop(t, v, y)
     assert loop.direction == 'counter-clockwise', loop
     assert loop.rises_with_command == (gain > 0)
-    # measured over seeds 0-29: 4.3-10 % of the span (the play is 0.3 mA of about 4 mA)
+    # measured over seeds 0-29: 4.3-10 % of the span (bench/measured_loops.py --spreads)
     assert 0.02 < loop.half_width_share < 0.2, loop
     assert 'counter-clockwise' in loop.words()
 
@@ -91,7 +91,7 @@ def test_a_staircase_command_traces_the_papers_loop_too(seed):
     loop = measured_loop(t, v, y)
     assert loop.direction == 'counter-clockwise', loop
     assert loop.rises_with_command == (gain > 0)
-    # measured over seeds 0-29: 3.8-8.8 % of the span
+    # measured over seeds 0-29: 4.4-8.7 % of the span (bench/measured_loops.py --spreads)
     assert loop.half_width_share > 0.02, loop
 
 
