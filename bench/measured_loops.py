@@ -26,7 +26,9 @@ With ``--spreads`` it prints instead the ranges over seeds 0-29 that
 ``test/diagnosis/test_measured_loop.py``'s bounds come from: the half-width
 of a Dahl friction force over its size, and of the paper's loop (reference
 simulator) as a share of the span, under a multisine and under a staircase of
-held steps (a few seconds).
+held steps; a band, a play and a single-valued curve under a command with
+noise of 0.5-5 % of its span; a play with a negative gain whose swing barely
+exceeds its dead band (the documented limit). A few seconds.
 
 Usage: ``python bench/measured_loops.py [--data ../shared/data] [--spreads]``
 """
@@ -54,6 +56,7 @@ def spreads(seeds: range = range(30)) -> None:
     """Print the ranges the test's bounds come from (the test's own generators)."""
     from friction_reference import euler_dahl
     import numpy as np
+    from play_reference import play
     from reference_sim import backlash, hysteresis
     from test_measured_loop import _excitation
 
@@ -82,6 +85,28 @@ def spreads(seeds: range = range(30)) -> None:
         y = gain * x + rng.normal(0.0, 0.005 * abs(gain) * np.ptp(x), v.size)
         loop = measured_loop(np.arange(v.size) * 0.02, v, y)
         steps.append((loop.direction, loop.half_width_share))
+    t = np.arange(4000) * 0.01
+    clean = np.sin(2 * np.pi * t / 8.0)
+    for share in (0.005, 0.01, 0.02, 0.05):
+        bands, curves, dirs = [], [], set()
+        for seed in range(10):
+            rng = np.random.default_rng(seed)
+            v = clean + rng.normal(0.0, 2.0 * share, t.size)
+            e = rng.normal(0.0, 0.01, t.size)
+            band = measured_loop(t, v, clean + 0.3 * np.sign(np.gradient(clean, t)) + e)
+            lag = measured_loop(t, v, play(clean, 0.3, clean[0]) + e)
+            curve = measured_loop(t, v, clean + e)
+            bands.append(band.half_width)
+            curves.append(curve.half_width_share)
+            dirs |= {f'band {band.direction}', f'play {lag.direction}',
+                     f'curve {curve.direction}'}
+        print(f'command noise {100 * share:g} % of the span, seeds 0-9: {", ".join(sorted(dirs))};'
+              f' band of 0.3 read {min(bands):.3g}-{max(bands):.3g}; curve up to '
+              f'{100 * max(curves):.2f} % of the span')
+    for dead_band in (0.8, 0.9, 0.95):
+        loop = measured_loop(t, clean, -play(clean, dead_band, clean[0]))
+        print(f'a play of half-width {dead_band} on a swing of +-1, negative gain: '
+              f'{loop.direction} (swing {2.0 / (2 * dead_band):.2f} x the dead band)')
     for name, rows, what in (('Dahl friction (multisine)', friction, 'of the force'),
                              ("the paper's loop (multisine)", paper, 'of the span'),
                              ("the paper's loop (staircase)", steps, 'of the span')):

@@ -31,10 +31,13 @@ does not decide, is read as recorded):
   the measurement's span).
 
 The direction of each sample is its sweep's (between the command's
-reversals beyond 2 % of its span, so noise on a measured command does not
-flip it); a hold at a reversal, before the command has left the extreme by
-more than its noise, keeps the direction that brought it there, and a
-hold inside a sweep (a staircase) the sweep's. The half-width is measured
+reversals beyond 2 % of its span and beyond 6 x its noise, so noise on a
+measured command does not flip it); a hold at a reversal, before the
+command has left the extreme by more than its noise, keeps the direction
+that brought it there, and a hold inside a sweep (a staircase) the
+sweep's. A play whose swing barely exceeds its dead band and whose gain is
+negative is read as recorded (its mid-line is flat between the tips), so
+clockwise: the frame is that of the levels, not of the tips. The half-width is measured
 level by level: the command's range is cut into :data:`N_LEVELS` bins of
 equal counts of distinct command values (so a long hold does not swallow
 the bins), and in each the rising samples are set against the falling ones
@@ -80,6 +83,10 @@ N_LEVELS = 12
 MIN_SAMPLES = 3
 #: A hold at a reversal lasts while the command stays within this many noise sigmas.
 HOLD_SIGMAS = 8.0
+#: A reversal is a move back by this share of the command's span ...
+REVERSAL_SHARE = 0.02
+#: ... and by this many of the command's noise sigmas (a measured command's noise).
+REVERSAL_SIGMAS = 6.0
 
 NO_SWEEP = 'the command does not sweep both ways, so the record traces no loop'
 FEW_SAMPLES = ('too few samples of each direction at the same command levels to measure '
@@ -197,7 +204,10 @@ def _noise_sigma(v: np.ndarray) -> float:
 
 def _sweeps(v: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Per sample: its sweep's direction (+1, -1, 0), mean rate and span."""
-    idx, dirs = reversal_indices(v)
+    sigma = _noise_sigma(v)
+    # a reversal is a move beyond 2 % of the span, and beyond the command's noise
+    idx, dirs = reversal_indices(v, tolerance=max(REVERSAL_SHARE * float(np.ptp(v)),
+                                                  REVERSAL_SIGMAS * sigma))
     n = v.size
     direction = np.zeros(n)
     rate = np.full(n, np.nan)
@@ -206,7 +216,7 @@ def _sweeps(v: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.nd
         return direction, rate, span
     edges = [0] + [int(i) for i in idx] + [n - 1]
     signs = [-int(dirs[0])] + [int(d) for d in dirs]
-    hold_tol = max(HOLD_SIGMAS * _noise_sigma(v), 1e-12 * float(np.ptp(v)))
+    hold_tol = max(HOLD_SIGMAS * sigma, 1e-12 * float(np.ptp(v)))
     for k, d in enumerate(signs):
         a, b = edges[k], edges[k + 1]
         if b <= a:
