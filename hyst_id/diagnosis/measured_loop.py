@@ -35,9 +35,10 @@ reversals beyond 2 % of its span and beyond 6 x its noise, so noise on a
 measured command does not flip it); a hold at a reversal, before the
 command has left the extreme by more than its noise, keeps the direction
 that brought it there, and a hold inside a sweep (a staircase) the
-sweep's. A play whose swing barely exceeds its dead band and whose gain is
-negative is read as recorded (its mid-line is flat between the tips), so
-clockwise: the frame is that of the levels, not of the tips. The half-width is measured
+sweep's. The mid-line's fall is the larger of its fall through the levels
+and the fall between the tips (the mean measurement over the command's top
+and bottom :data:`TIP_SHARE`, both directions together): a play barely
+swung past its dead band has a mid-line flat between its tips. The half-width is measured
 level by level: the command's range is cut into :data:`N_LEVELS` bins of
 equal counts of distinct command values (so a long hold does not swallow
 the bins), and in each the rising samples are set against the falling ones
@@ -83,6 +84,8 @@ N_LEVELS = 12
 MIN_SAMPLES = 3
 #: A hold at a reversal lasts while the command stays within this many noise sigmas.
 HOLD_SIGMAS = 8.0
+#: Share of the command's range at each end whose measurement marks the loop's tips.
+TIP_SHARE = 0.05
 #: A reversal is a move back by this share of the command's span ...
 REVERSAL_SHARE = 0.02
 #: ... and by this many of the command's noise sigmas (a measured command's noise).
@@ -280,6 +283,21 @@ def _midline_rise(levels: list[tuple[float, float, float, float]]) -> float:
     return float(slope * np.ptp(vm))
 
 
+def _tips_rise(v: np.ndarray, y: np.ndarray, keep: np.ndarray) -> float:
+    """Mean measurement at the command's top :data:`TIP_SHARE` less that at its bottom.
+
+    Both directions together, so a band's two sides cancel; a loop whose
+    mid-line is flat between its tips (a play barely swung past its dead
+    band) still shows here which way its ends go.
+    """
+    vk, yk = v[keep], y[keep]
+    lo, hi = float(vk.min()), float(vk.max())
+    top, bottom = vk >= hi - TIP_SHARE * (hi - lo), vk <= lo + TIP_SHARE * (hi - lo)
+    if not (np.any(top) and np.any(bottom)):
+        return 0.0
+    return float(np.mean(yk[top]) - np.mean(yk[bottom]))
+
+
 def measured_loop(t_s: np.ndarray, command: np.ndarray, measurement: np.ndarray
                   ) -> MeasuredLoop:
     """Describe the loop a recording traces (see the module docstring).
@@ -317,7 +335,8 @@ def measured_loop(t_s: np.ndarray, command: np.ndarray, measurement: np.ndarray
     raw_gap = _half_gap(levels)
     if not np.isfinite(raw_gap):
         return MeasuredLoop('thin', True, nan, nan, nan, nan, nan, nan, nan, nan, FEW_SAMPLES)
-    rises = not _midline_rise(levels) < -2.0 * abs(raw_gap)
+    rise = min(_midline_rise(levels), _tips_rise(v, y, moving))
+    rises = not rise < -2.0 * abs(raw_gap)
     ys = y if rises else -y
     gap = raw_gap if rises else -raw_gap
     y_span = float(np.ptp(y))

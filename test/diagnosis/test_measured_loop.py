@@ -165,6 +165,16 @@ def test_a_noisy_measured_command_keeps_the_direction(noise_share, seed):
         assert measured_loop(t, v, clean + e).direction == 'thin'
 
 
+@pytest.mark.parametrize('dead_band', [0.5, 0.8, 0.9])
+def test_a_negative_gain_play_near_its_dead_band_is_negated(dead_band):
+    # swung 1.11-2 x past its dead band, the play's mid-line is flat between its tips:
+    # the tips' fall sets the frame (at 1.05 x it does not: documented)
+    t = np.arange(4000) * 0.01
+    v = np.sin(2 * np.pi * t / 8.0)
+    loop = measured_loop(t, v, -play(v, dead_band, v[0]))
+    assert loop.direction == 'counter-clockwise' and not loop.rises_with_command, loop
+
+
 def test_a_falling_measurement_is_read_negated_and_said_so():
     t, v = _triangles([10.0] * 6, [4.0] * 6)
     loop = measured_loop(t, v, -(v + np.sign(np.gradient(v, t))))
