@@ -65,6 +65,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from hyst_id.errors import RecordingError
+from hyst_id.signals.noise import robust_noise_std
 from hyst_id.signals.reversals import reversal_indices
 
 __all__ = ['MeasuredLoop', 'measured_loop', 'MIN_SAMPLES', 'N_LEVELS', 'RATE_GROWTH',
@@ -198,16 +199,9 @@ class MeasuredLoop:
         return out
 
 
-def _noise_sigma(v: np.ndarray) -> float:
-    """Robust sigma of white noise on the command (from its second differences)."""
-    if v.size < 3:
-        return 0.0
-    return float(np.median(np.abs(np.diff(v, 2)))) / (0.6745 * np.sqrt(6.0))
-
-
 def _sweeps(v: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Per sample: its sweep's direction (+1, -1, 0), mean rate and span."""
-    sigma = _noise_sigma(v)
+    sigma = robust_noise_std(v) if v.size >= 4 else 0.0
     # a reversal is a move beyond 2 % of the span, and beyond the command's noise
     idx, dirs = reversal_indices(v, tolerance=max(REVERSAL_SHARE * float(np.ptp(v)),
                                                   REVERSAL_SIGMAS * sigma))
