@@ -53,46 +53,24 @@ from hyst_id.identification.loop import loop_orientation  # noqa: E402
 
 
 def spreads(seeds: range = range(30)) -> None:
-    """Print the ranges the test's bounds come from (the test's own generators)."""
-    from friction_reference import euler_dahl
+    """Print the ranges the test's bounds come from (the test's own cases)."""
     import numpy as np
     from play_reference import play
-    from reference_sim import backlash, hysteresis
-    from test_measured_loop import _excitation
-
-    def chain(v):
-        return backlash(hysteresis(v, 1.01, 1.05, 0.10, 0.15, -0.25, 0.50, 14.0, 7.0), 1.0,
-                        -0.15, 0.15)
+    from test_measured_loop import dahl_case, noisy_sine_case, papers_loop_case, staircase_case
 
     friction, paper, steps = [], [], []
     for seed in seeds:
-        rng = np.random.default_rng(seed)
-        t, v = _excitation(rng)
-        force = rng.uniform(0.05, 0.4) * np.ptp(v)
-        y = 2.0 * v + force * euler_dahl(v, 0.01 * np.ptp(v), substeps=50)
-        loop = measured_loop(t, v, y + rng.normal(0.0, 0.005 * np.ptp(y), t.size))
+        t, v, y, force = dahl_case(seed)
+        loop = measured_loop(t, v, y)
         friction.append((loop.direction, loop.half_width / force))
-        rng = np.random.default_rng(seed)
-        t, v = _excitation(rng)
-        gain = rng.choice([-1.0, 1.0]) * rng.uniform(0.5, 50.0)
-        y = gain * chain(v) + rng.uniform(-10, 10)
-        loop = measured_loop(t, v, y + rng.normal(0.0, 0.005 * np.ptp(y), t.size))
+        loop = measured_loop(*papers_loop_case(seed)[:3])
         paper.append((loop.direction, loop.half_width_share))
-        rng = np.random.default_rng(seed)
-        v = np.repeat(rng.uniform(6.5, 11.5, 60), 50)
-        gain = rng.choice([-1.0, 1.0]) * rng.uniform(0.5, 50.0)
-        x = chain(v)
-        y = gain * x + rng.normal(0.0, 0.005 * abs(gain) * np.ptp(x), v.size)
-        loop = measured_loop(np.arange(v.size) * 0.02, v, y)
+        loop = measured_loop(*staircase_case(seed)[:3])
         steps.append((loop.direction, loop.half_width_share))
-    t = np.arange(4000) * 0.01
-    clean = np.sin(2 * np.pi * t / 8.0)
     for share in (0.005, 0.01, 0.02, 0.05):
         bands, curves, dirs = [], [], set()
         for seed in range(10):
-            rng = np.random.default_rng(seed)
-            v = clean + rng.normal(0.0, 2.0 * share, t.size)
-            e = rng.normal(0.0, 0.01, t.size)
+            t, v, clean, e = noisy_sine_case(seed, share)
             band = measured_loop(t, v, clean + 0.3 * np.sign(np.gradient(clean, t)) + e)
             lag = measured_loop(t, v, play(clean, 0.3, clean[0]) + e)
             curve = measured_loop(t, v, clean + e)
@@ -103,6 +81,7 @@ def spreads(seeds: range = range(30)) -> None:
         print(f'command noise {100 * share:g} % of the span, seeds 0-9: {", ".join(sorted(dirs))};'
               f' band of 0.3 read {min(bands):.3g}-{max(bands):.3g}; curve up to '
               f'{100 * max(curves):.2f} % of the span')
+    t, _, clean, _ = noisy_sine_case(0, 0.0)
     for dead_band in (0.8, 0.9, 0.95):
         loop = measured_loop(t, clean, -play(clean, dead_band, clean[0]))
         print(f'a play of half-width {dead_band} on a swing of +-1, negative gain: '

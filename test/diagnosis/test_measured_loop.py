@@ -62,15 +62,52 @@ def _triangles(spans, periods_s, dt_s: float = 0.01):
     return np.arange(v.size) * dt_s, v
 
 
-@pytest.mark.parametrize('seed', SEEDS)
-def test_the_papers_loop_runs_counter_clockwise_in_either_sign(seed):
+def papers_chain(v: np.ndarray) -> np.ndarray:
+    """The paper's H then B, by the reference simulator, at fixed parameters."""
+    return backlash(hysteresis(v, 1.01, 1.05, 0.10, 0.15, -0.25, 0.50, 14.0, 7.0), 1.0,
+                    -0.15, 0.15)
+
+
+def papers_loop_case(seed: int):
+    """A random multisine through the paper's chain, a random gain of either sign, noise."""
     rng = np.random.default_rng(seed)
     t, v = _excitation(rng)
-    x = backlash(hysteresis(v, 1.01, 1.05, 0.10, 0.15, -0.25, 0.50, 14.0, 7.0), 1.0,
-                 -0.15, 0.15)
     gain = rng.choice([-1.0, 1.0]) * rng.uniform(0.5, 50.0)
-    y = gain * x + rng.uniform(-10, 10)
-    y = y + rng.normal(0.0, 0.005 * np.ptp(y), t.size)
+    y = gain * papers_chain(v) + rng.uniform(-10, 10)
+    return t, v, y + rng.normal(0.0, 0.005 * np.ptp(y), t.size), gain
+
+
+def staircase_case(seed: int):
+    """Random steps held 1 s through the paper's chain, a random gain of either sign."""
+    rng = np.random.default_rng(seed)
+    v = np.repeat(rng.uniform(6.5, 11.5, 60), 50)
+    gain = rng.choice([-1.0, 1.0]) * rng.uniform(0.5, 50.0)
+    x = papers_chain(v)
+    y = gain * x + rng.normal(0.0, 0.005 * abs(gain) * np.ptp(x), v.size)
+    return np.arange(v.size) * 0.02, v, y, gain
+
+
+def dahl_case(seed: int):
+    """A random multisine on a spring with a Dahl friction force of random size."""
+    rng = np.random.default_rng(seed)
+    t, v = _excitation(rng)
+    force = rng.uniform(0.05, 0.4) * np.ptp(v)
+    y = 2.0 * v + force * euler_dahl(v, 0.01 * np.ptp(v), substeps=50)
+    return t, v, y + rng.normal(0.0, 0.005 * np.ptp(y), t.size), force
+
+
+def noisy_sine_case(seed: int, noise_share: float):
+    """A unit sine measured with noise of ``noise_share`` of its span; the clean sine; noise."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(4000) * 0.01
+    clean = np.sin(2 * np.pi * t / 8.0)
+    v = clean + rng.normal(0.0, 2.0 * noise_share, t.size)
+    return t, v, clean, rng.normal(0.0, 0.01, t.size)
+
+
+@pytest.mark.parametrize('seed', SEEDS)
+def test_the_papers_loop_runs_counter_clockwise_in_either_sign(seed):
+    t, v, y, gain = papers_loop_case(seed)
     loop = measured_loop(t, v, y)
     assert loop.direction == 'counter-clockwise', loop
     assert loop.rises_with_command == (gain > 0)
@@ -82,13 +119,7 @@ def test_the_papers_loop_runs_counter_clockwise_in_either_sign(seed):
 @pytest.mark.parametrize('seed', SEEDS)
 def test_a_staircase_command_traces_the_papers_loop_too(seed):
     # random steps held 1 s: the holds inside a sweep keep the sweep's direction
-    rng = np.random.default_rng(seed)
-    v = np.repeat(rng.uniform(6.5, 11.5, 60), 50)
-    t = np.arange(v.size) * 0.02
-    x = backlash(hysteresis(v, 1.01, 1.05, 0.10, 0.15, -0.25, 0.50, 14.0, 7.0), 1.0,
-                 -0.15, 0.15)
-    gain = rng.choice([-1.0, 1.0]) * rng.uniform(0.5, 50.0)
-    y = gain * x + rng.normal(0.0, 0.005 * abs(gain) * np.ptp(x), t.size)
+    t, v, y, gain = staircase_case(seed)
     loop = measured_loop(t, v, y)
     assert loop.direction == 'counter-clockwise', loop
     assert loop.rises_with_command == (gain > 0)
@@ -98,11 +129,7 @@ def test_a_staircase_command_traces_the_papers_loop_too(seed):
 
 @pytest.mark.parametrize('seed', SEEDS)
 def test_a_friction_force_on_the_travel_runs_clockwise_with_its_size(seed):
-    rng = np.random.default_rng(seed)
-    t, v = _excitation(rng)
-    force = rng.uniform(0.05, 0.4) * np.ptp(v)
-    y = 2.0 * v + force * euler_dahl(v, 0.01 * np.ptp(v), substeps=50)
-    y = y + rng.normal(0.0, 0.005 * np.ptp(y), t.size)
+    t, v, y, force = dahl_case(seed)
     loop = measured_loop(t, v, y)
     assert loop.direction == 'clockwise', loop
     # measured over seeds 0-29: 0.79-0.89 of the force (the multisine's minor sweeps
@@ -149,11 +176,7 @@ def test_holds_at_the_reversals_make_no_loop_and_keep_a_real_one(command_noise):
 def test_a_noisy_measured_command_keeps_the_direction(noise_share, seed):
     # noise on the command of 0.5-5 % of its span (a measured displacement): reversals
     # need a move beyond 6 x that noise, else noise turns make up sweeps
-    rng = np.random.default_rng(seed)
-    t = np.arange(4000) * 0.01
-    clean = np.sin(2 * np.pi * t / 8.0)
-    v = clean + rng.normal(0.0, 2.0 * noise_share, t.size)
-    e = rng.normal(0.0, 0.01, t.size)
+    t, v, clean, e = noisy_sine_case(seed, noise_share)
     band = measured_loop(t, v, clean + 0.3 * np.sign(np.gradient(clean, t)) + e)
     lag = measured_loop(t, v, play(clean, 0.3, clean[0]) + e)
     assert band.direction == 'clockwise', band
