@@ -38,8 +38,8 @@ that brought it there, and a hold inside a sweep (a staircase) the
 sweep's. The mid-line's fall is the larger of its fall through the levels
 and the fall between the tips (the mean measurement over the command's top
 and bottom :data:`TIP_SHARE`, both directions together): a play barely
-swung past its dead band has a mid-line flat between its tips. The half-width is measured
-level by level: the command's range is cut into :data:`N_LEVELS` bins of
+swung past its dead band has a mid-line flat between its tips. The
+half-width is measured level by level: the command's range is cut into :data:`N_LEVELS` bins of
 equal counts of distinct command values (so a long hold does not swallow
 the bins), and in each the rising samples are set against the falling ones
 at the same command (one straight line through the bin for both, shifted
