@@ -38,6 +38,8 @@ from pathlib import Path
 import sys
 import time
 
+import numpy as np
+
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / 'bench'))
 sys.path.insert(0, str(ROOT))
@@ -56,6 +58,17 @@ def _params(finding) -> str:
     return ', '.join(f'{k} {q.value:.3g} {q.unit}' for k, q in list(finding.params.items())[:3])
 
 
+def _as_the_cli(data: Path, rec):
+    """The recording as ``hyst-id diagnose`` reads it; prints how many stamps differ."""
+    cli = read_csv(data / rec.source, 'position', columns=(0, 4, 6), time_scale=0.001,
+                   command_unit='mm', measurement_unit='N')
+    if cli.t_s.shape == rec.t_s.shape:
+        differ = int(np.count_nonzero(cli.t_s != rec.t_s))
+        print(f'{rec.source}: {differ} of {rec.t_s.size} time stamps differ from the '
+              "bench reader's in the last bits (t x 0.001 against t / 1000)")
+    return cli
+
+
 def main() -> int:
     """Diagnose each recording and print what the docs' tables hold."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -72,9 +85,8 @@ def main() -> int:
     args = ap.parse_args()
     recs = load_all(Path(args.data))
     if args.cli_reader:
-        recs = [read_csv(Path(args.data) / r.source, 'position', columns=(0, 4, 6),
-                         time_scale=0.001, command_unit='mm', measurement_unit='N')
-                if r.source.startswith('pneumatic') else r for r in recs]
+        recs = [_as_the_cli(Path(args.data), r) if r.source.startswith('pneumatic') else r
+                for r in recs]
     for rec in recs:
         if args.only and args.only not in rec.source:
             continue
