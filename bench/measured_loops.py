@@ -28,7 +28,8 @@ of a Dahl friction force over its size, and of the paper's loop (reference
 simulator) as a share of the span, under a multisine and under a staircase of
 held steps; a band, a play and a single-valued curve under a command with
 noise of 0.5-5 % of its span; a play with a negative gain whose swing barely
-exceeds its dead band (the documented limit). A few seconds.
+exceeds its dead band (the documented limit); and how much the half-width
+moves when the inputs' last bits do. Half a minute.
 
 Usage: ``python bench/measured_loops.py [--data ../shared/data] [--spreads]``
 """
@@ -56,7 +57,8 @@ def spreads(seeds: range = range(30)) -> None:
     """Print the ranges the test's bounds come from (the test's own cases)."""
     import numpy as np
     from play_reference import play
-    from test_measured_loop import dahl_case, noisy_sine_case, papers_loop_case, staircase_case
+    from test_measured_loop import dahl_case, last_bits_moved, noisy_sine_case, papers_loop_case
+    from test_measured_loop import staircase_case
 
     friction, paper, steps = [], [], []
     for seed in seeds:
@@ -86,6 +88,20 @@ def spreads(seeds: range = range(30)) -> None:
         loop = measured_loop(t, clean, -play(clean, dead_band, clean[0]))
         print(f'a play of half-width {dead_band} on a swing of +-1, negative gain: '
               f'{loop.direction} (swing {2.0 / (2 * dead_band):.2f} x the dead band)')
+    worst, runs = 0.0, 0
+    for case in (dahl_case, papers_loop_case, staircase_case):
+        for seed in seeds:
+            t, v, y, _ = case(seed)
+            a = measured_loop(t, v, y)
+            for k in range(5):
+                rng = np.random.default_rng(k)
+                b = measured_loop(*(last_bits_moved(x, rng) for x in (t, v, y)))
+                worst = max(worst, abs(b.half_width - a.half_width) / abs(a.half_width))
+                runs += 1
+                if (a.direction, a.rises_with_command) != (b.direction, b.rises_with_command):
+                    print(f'  {case.__name__}({seed}): the direction moved with the last bits')
+    print(f'last bits moved (up to 4 ulps a sample), {runs} runs: largest relative change of '
+          f'the half-width {worst:.1e}')
     for name, rows, what in (('Dahl friction (multisine)', friction, 'of the force'),
                              ("the paper's loop (multisine)", paper, 'of the span'),
                              ("the paper's loop (staircase)", steps, 'of the span')):

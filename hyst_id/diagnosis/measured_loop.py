@@ -65,7 +65,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from hyst_id.errors import RecordingError
-from hyst_id.signals.noise import robust_noise_std
+from hyst_id.signals.noise import REPEAT_TOLERANCE, robust_noise_std
 from hyst_id.signals.reversals import reversal_indices
 
 __all__ = ['MeasuredLoop', 'measured_loop', 'MIN_SAMPLES', 'N_LEVELS', 'RATE_GROWTH',
@@ -230,6 +230,25 @@ def _sweeps(v: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.nd
     return direction, rate, span
 
 
+def _level_edges(v: np.ndarray) -> np.ndarray:
+    """Edges of :data:`N_LEVELS` bins of equal counts of distinct command values.
+
+    Values within round-off (:data:`~hyst_id.signals.noise.REPEAT_TOLERANCE`)
+    count as one (a held step stays one value when its last bits move), and
+    each inner edge lies midway between two distinct values, so no sample
+    sits on an edge where a last-bit change would move it to the next bin.
+    """
+    x = np.sort(v)
+    if x.size == 0:
+        return x
+    keep = np.r_[True, np.diff(x) > REPEAT_TOLERANCE * float(np.max(np.abs(x)))]
+    d = x[keep]
+    if d.size < 2:
+        return d
+    at = np.unique(np.round(np.linspace(0, d.size - 1, N_LEVELS + 1)).astype(int))[1:-1]
+    return np.unique(np.r_[d[0], 0.5 * (d[at] + d[at + 1]), d[-1]])
+
+
 def _levels(v: np.ndarray, y: np.ndarray, direction: np.ndarray, edges: np.ndarray,
             keep: np.ndarray) -> list[tuple[float, float, float, float]]:
     """Per level with both directions: (weight, mean command, rising and falling value).
@@ -324,7 +343,7 @@ def measured_loop(t_s: np.ndarray, command: np.ndarray, measurement: np.ndarray
     nan = float('nan')
     if not np.any(direction > 0) or not np.any(direction < 0):
         return MeasuredLoop('thin', True, nan, nan, nan, nan, nan, nan, nan, nan, NO_SWEEP)
-    edges = np.unique(np.quantile(np.unique(v[moving]), np.linspace(0.0, 1.0, N_LEVELS + 1)))
+    edges = _level_edges(v[moving])
     levels = _levels(v, y, direction, edges, moving) if edges.size >= 2 else []
     raw_gap = _half_gap(levels)
     if not np.isfinite(raw_gap):
