@@ -172,12 +172,19 @@ def test_bad_params_file_is_a_one_line_config_error(ros_domain, tmp_path):
         f'    {k}: {float(v)!r}\n' for k, v in {**PAPER, 'c_l': 0.9}.items()))
     bad_type = tmp_path / 'type.yaml'
     bad_type.write_text('compensator:\n  ros__parameters:\n    max_command: high\n')
-    for path, needle in ((bad_value, 'not proper'), (bad_type, 'double')):
+    empty = tmp_path / 'empty.yaml'      # an empty list has no type in ROS 2: not initialised
+    empty.write_text('/**:\n  ros__parameters:\n    topics: []\n')
+    bad_topic = tmp_path / 'topic.yaml'
+    bad_topic.write_text('/**:\n  ros__parameters:\n    topics:\n      desired_topic: a-b\n')
+    for cls, path, needle in ((Compensator, bad_value, 'not proper'),
+                              (Compensator, bad_type, 'double'),
+                              (Recorder, empty, 'topics is given no value'),
+                              (Compensator, bad_topic, "'a-b' is not a ROS topic name")):
         context = rclpy.Context()
         rclpy.init(args=['--ros-args', '--params-file', str(path)], context=context)
         try:
             with pytest.raises(ConfigError, match=needle) as info:
-                Compensator(context=context)
+                cls(context=context)
             assert '\n' not in str(info.value)
         finally:
             context.try_shutdown()

@@ -27,6 +27,7 @@ from rclpy.exceptions import (
     InvalidParameterTypeException,
     InvalidParameterValueException,
     ParameterException,
+    ParameterUninitializedException,
 )
 from rclpy.node import Node
 from rclpy.parameter import Parameter
@@ -144,6 +145,12 @@ class HystNode(Node):
                     f'({first_line(exc)})') from None
             except (InvalidParameterValueException, ParameterException) as exc:
                 raise ConfigError(f'parameter {p.name}: {first_line(exc)}') from None
+            try:
+                self.get_parameter(p.name)
+            except ParameterUninitializedException:
+                raise ConfigError(f'parameter {p.name} is given no value (an empty list [] has '
+                                  f'no element type in ROS 2); give it like {default!r}'
+                                  ) from None
         values = self.param_values()
         reason = self._check_all(values, set(values))
         if reason:

@@ -21,6 +21,8 @@ import math
 from typing import Any, Iterable
 
 from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
+from rclpy.exceptions import InvalidTopicNameException
+from rclpy.validate_topic_name import validate_topic_name
 
 from hyst_id.io.interface_types import FLOAT64_TYPE, SCALAR_TYPES, STAMPED_VALUE_TYPE
 from hyst_id.io.recording import CHANNELS
@@ -68,12 +70,31 @@ class Param:
         """Return why ``value`` is invalid for this parameter, or None."""
         if self.choices and value not in self.choices:
             return f'{self.name} must be one of {", ".join(self.choices)}; got {value!r}'
+        bad_topic = self._bad_topic(value)
+        if bad_topic:
+            return bad_topic
         if self.low is not None and isinstance(value, (int, float)) \
                 and not isinstance(value, bool):
             high = math.inf if self.high is None else self.high
             if not (math.isfinite(value) and self.low <= value <= high):
                 return (f'{self.name} must be in [{self.low:g}, {high:g}]'
                         f'{" " + self.unit if self.unit else ""}; got {value!r}')
+        return None
+
+    def _bad_topic(self, value: Any) -> str | None:
+        """Why a topic name (``*_topic``) or a ``topics`` list entry is no ROS topic name."""
+        if self.name.endswith('_topic') and isinstance(value, str):
+            names = [value]
+        elif self.name == 'topics' and isinstance(value, (list, tuple)):
+            names = [t for t in value if isinstance(t, str) and t and t != '*']
+        else:
+            return None
+        for name in names:
+            try:
+                validate_topic_name(name)
+            except InvalidTopicNameException as exc:
+                why = str(exc).splitlines()[0].rstrip(':').replace('Invalid topic name: ', '')
+                return f'{self.name}: {name!r} is not a ROS topic name ({why})'
         return None
 
 
