@@ -246,8 +246,11 @@ class Compensator:
         lim = self.limits
         if not math.isfinite(v):
             v = self._v
-        if t_s is not None and self._t_prev is not None and math.isfinite(lim.max_rate_per_s):
-            dv_max = lim.max_rate_per_s * max(t_s - self._t_prev, 0.0)
+        if t_s is not None and math.isfinite(lim.max_rate_per_s):
+            # the first sample after a reset starts from the held command: no time has
+            # passed for the actuator to move (a 6 mA jump got through here before)
+            elapsed = 0.0 if self._t_prev is None else max(t_s - self._t_prev, 0.0)
+            dv_max = lim.max_rate_per_s * elapsed
             v = min(max(v, self._v - dv_max), self._v + dv_max)
         if t_s is not None:
             self._t_prev = t_s

@@ -52,6 +52,16 @@ def test_limits_are_never_exceeded_and_state_follows_what_was_sent():
     assert comp.state[0] == commands[-1]
 
 
+def test_the_rate_limit_starts_from_the_held_command():
+    """The first command after a reset is the held one: no time has passed to move."""
+    comp = Compensator(None, CommandLimits(4.0, 20.0, max_rate_per_s=1.0), v0=9.0)
+    assert comp.step(15.0, 100.0) == 9.0
+    assert comp.step(15.0, 100.5) == pytest.approx(9.5)
+    comp.reset(12.0)
+    assert comp.step(4.0, 200.0) == 12.0
+    assert comp.step(4.0, 201.0) == pytest.approx(11.0)
+
+
 def test_no_model_passes_through():
     comp = Compensator(None, CommandLimits(0.0, 20.0), v0=9.0)
     np.testing.assert_array_equal(comp.run(DESIRED), DESIRED)
