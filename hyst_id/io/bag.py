@@ -208,8 +208,8 @@ class BagWriter:
         self.close()
         return False
 
-    def add_topic(self, name: str, msgtype: str,
-                  offered_qos: Sequence[Mapping[str, Any]] = ()) -> None:
+    def add_topic(self, name: str, msgtype: str, offered_qos: Sequence[Mapping[str, Any]] = (),
+                  key: str | None = None) -> None:
         """Register topic ``name`` carrying ``msgtype`` (e.g. ``'std_msgs/msg/Float64'``).
 
         ``offered_qos`` are the publishers' QoS profiles as mappings of rmw
@@ -217,13 +217,14 @@ class BagWriter:
         ``liveliness`` as rmw enum integers; ``deadline_ns``, ``lifespan_ns``,
         ``liveliness_lease_duration_ns``; ``avoid_ros_namespace_conventions``),
         stored in the bag as ``ros2 bag record`` stores them, so that a
-        player can offer the same (a latched topic replays latched).
+        player can offer the same (a latched topic replays latched). ``key``
+        (default ``name``) is what :meth:`write` takes: a second type on a topic.
         """
         if msgtype not in self.typestore.types:
             raise ConfigError(f'unknown message type {msgtype!r} for topic {name}')
-        if name in self._connections:
-            raise ValueError(f'topic {name} already added')
-        self._connections[name] = self._writer.add_connection(
+        if (key or name) in self._connections:
+            raise ValueError(f'topic {key or name} already added')
+        self._connections[key or name] = self._writer.add_connection(
             name, msgtype, typestore=self.typestore,
             offered_qos_profiles=[rosbags_qos(q) for q in offered_qos])
 

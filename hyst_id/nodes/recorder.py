@@ -18,6 +18,15 @@ Each configured topic is subscribed once it has a publisher: its type comes
 from the ROS graph (imported with importlib), its QoS is adapted to the
 publishers (best effort if any publisher is, transient local if all are),
 and messages are written as received, still serialised (``raw=True``).
+Every second the publishers are looked at again. A publisher whose QoS the
+subscription does not match (a best-effort one joining reliable ones) makes
+the recorder subscribe again with QoS that matches all (the new subscription
+before the old one goes; a message both deliver is written once). A topic
+carrying a second type is recorded in it too where the middleware allows;
+Fast DDS takes one type per topic in a process, so there the second type's
+messages are not recorded and ``/diagnostics`` says so (ERROR, naming the
+topic and type) for the recorder's life. Before, the first type and QoS seen
+were kept and a second publisher's messages were lost without a word.
 
 Log time of a message is its *source timestamp* (when the publisher sent
 it, from the middleware), not when the recorder got it: so a position
@@ -37,9 +46,11 @@ plus any messages still in transit to it.
 
 from __future__ import annotations
 
+from collections import deque
 import datetime
 from pathlib import Path
 import threading
+import time
 from typing import Any
 
 import rclpy
@@ -57,6 +68,7 @@ from hyst_id.nodes.support import (
     spin_node,
     topic_params,
 )
+from hyst_id.nodes.support.ros import first_line
 
 __all__ = ['PARAMS', 'Recorder', 'default_bag_name', 'main']
 
@@ -124,7 +136,9 @@ class Recorder(HystNode):
         self._lock = threading.Lock()
         self._writer = BagWriter(self.path, chunk_size=self.p('chunk_size'),
                                  chunk_span_s=self.p('chunk_span_s')).open()
-        self._subs: dict[str, Any] = {}
+        #: (topic, type) -> [subscription, its QoS, dedupe window end (ns), recent keys]
+        self._subs: dict[tuple[str, str], list] = {}
+        self._unrecordable: dict[tuple[str, str], str] = {}
         self.counts: dict[str, int] = {}
         self.create_steady_timer(self.p('discovery_period_s'), self._discover)
         self.create_steady_timer(self.p('flush_period_s'), self._flush)
@@ -134,50 +148,112 @@ class Recorder(HystNode):
         self._discover()
 
     @property
+    def not_recorded(self) -> dict[str, str]:
+        """``'topic (type)'`` -> why, for every publisher type the bag does not hold."""
+        return {f'{t} ({m})': why for (t, m), why in self._unrecordable.items()}
+
+    @property
     def subscribed(self) -> list[str]:
         """Topics subscribed so far."""
-        return list(self._subs)
+        return list(dict.fromkeys(topic for topic, _ in self._subs))
 
-    def _discover(self) -> None:
-        missing = [t for t in self._wanted if t not in self._subs]
-        if not missing or self._writer is None:
+    def _discover(self, recheck: bool = False) -> None:
+        """Subscribe to every type a wanted topic carries; with ``recheck``, follow its QoS.
+
+        A topic is recorded in every type its publishers offer (each its own
+        connection in the bag), and its subscription follows the publishers'
+        QoS: a best-effort publisher joining a reliable one makes the
+        subscription best effort, else its messages would not arrive.
+        """
+        if self._writer is None:
+            return
+        pending = [t for t in self._wanted if t not in self.counts]
+        if not pending and not recheck:
             return
         graph = dict(self.get_topic_names_and_types())
-        for topic in missing:
-            types = graph.get(topic)
+        for topic in (self._wanted if recheck else pending):
+            types = [m for m in graph.get(topic, []) if (topic, m) not in self._unrecordable]
             if not types:
                 continue
             infos = self.get_publishers_info_by_topic(topic)
-            if not infos:
-                continue
-            msgtype = types[0]
-            if len(types) > 1:
-                self.get_logger().warning(f'{topic} has several types {types}; recording '
-                                          f'{msgtype}')
-            try:
-                cls = message_class(msgtype)
-                with self._lock:
-                    self._writer.add_topic(topic, msgtype, [_offered(i.qos_profile)
-                                                            for i in infos])
-            except (ConfigError, ValueError) as exc:
-                self.get_logger().error(f'cannot record {topic}: {exc}')
-                self._wanted.remove(topic)
-                continue
-            qos = _qos_for(infos)
-            self._subs[topic] = self.create_subscription(
-                cls, topic, lambda data, info, t=topic: self._on_message(t, data, info), qos,
-                raw=True)
-            self.counts[topic] = 0
-            self.get_logger().info(f'recording {topic} ({msgtype}, '
-                                   f'{qos.reliability.name.lower()})')
+            for msgtype in types:
+                mine = [i for i in infos if i.topic_type == msgtype]
+                if not mine:
+                    continue
+                if (topic, msgtype) in self._subs:
+                    self._follow_qos(topic, msgtype, mine)
+                else:
+                    self._subscribe(topic, msgtype, mine)
 
-    def _on_message(self, topic: str, data: bytes, info: dict) -> None:
+    def _subscribe(self, topic: str, msgtype: str, infos: list) -> None:
+        first = not any(t == topic for t, _ in self._subs)
+        try:
+            cls = message_class(msgtype)
+            with self._lock:
+                self._writer.add_topic(topic, msgtype, [_offered(i.qos_profile) for i in infos],
+                                       key=None if first else f'{topic}\0{msgtype}')
+        except (ConfigError, ValueError) as exc:
+            self._unrecordable[(topic, msgtype)] = str(exc)
+            self.get_logger().error(f'cannot record {topic} ({msgtype}): {exc}')
+            return
+        self._subs[(topic, msgtype)] = [None, None, 0, deque(maxlen=256)]
+        try:
+            self._make_subscription(topic, msgtype, cls, _qos_for(infos))
+        except RuntimeError as exc:     # Fast DDS: one type per topic in a process
+            del self._subs[(topic, msgtype)]
+            why = ('this middleware takes one type per topic in a process; recording '
+                   f'{self._first_type(topic)}' if not first else first_line(exc))
+            self._unrecordable[(topic, msgtype)] = why
+            self.get_logger().error(f'{topic} carries several types: its {msgtype} messages '
+                                    f'are NOT recorded ({why})')
+            return
+        self.counts.setdefault(topic, 0)
+        self.get_logger().info(f'recording {topic} ({msgtype}, '
+                               f'{self._subs[(topic, msgtype)][1].reliability.name.lower()})')
+
+    def _make_subscription(self, topic: str, msgtype: str, cls: Any, qos: QoSProfile) -> None:
+        """(Re)subscribe; the old subscription goes after the new one is up (no gap)."""
+        entry = self._subs[(topic, msgtype)]
+        old = entry[0]
+        key = None if self._first_type(topic) == msgtype else f'{topic}\0{msgtype}'
+        entry[0] = self.create_subscription(
+            cls, topic, lambda data, info, k=(topic, msgtype), w=key or topic:
+            self._on_message(k, w, data, info), qos, raw=True)
+        entry[1] = qos
+        if old is not None:     # both deliver for a moment: drop repeats for 2 s
+            entry[2] = time.monotonic_ns() + 2 * 10**9
+            self.destroy_subscription(old)
+
+    def _first_type(self, topic: str) -> str:
+        return next(m for t, m in self._subs if t == topic)
+
+    def _follow_qos(self, topic: str, msgtype: str, infos: list) -> None:
+        want = _qos_for(infos)
+        have = self._subs[(topic, msgtype)][1]
+        if (want.reliability, want.durability) == (have.reliability, have.durability):
+            return
+        self.get_logger().warning(
+            f'{topic}: its publishers now offer {want.reliability.name.lower()}, '
+            f'{want.durability.name.lower()}; subscribing again so that every one is recorded')
+        self._make_subscription(topic, msgtype, message_class(msgtype), want)
+
+    def _on_message(self, key: tuple[str, str], writer_key: str, data: bytes,
+                    info: dict) -> None:
         t_ns = source_time_ns(self, info)
+        entry = self._subs[key]
+        stamp = info.get('source_timestamp')
+        if stamp:                    # the last messages, to drop repeats after a resubscription
+            seen = (stamp, hash(bytes(data)))
+            if entry[2] and seen in entry[3]:
+                if time.monotonic_ns() <= entry[2]:
+                    return
+                entry[2] = 0
+            entry[3].append(seen)
         with self._lock:
             if self._writer is None:
                 return
-            self._writer.write(topic, t_ns, data)
-            self.counts[topic] += 1
+            self._writer.write(writer_key, t_ns, data)
+            self.counts[key[0]] += 1
 
     def _flush(self) -> None:
         with self._lock:
@@ -185,12 +261,14 @@ class Recorder(HystNode):
                 self._writer.flush()
 
     def _status(self) -> None:
+        self._discover(recheck=True)
         total = sum(self.counts.values())
-        missing = [t for t in self._wanted if t not in self._subs]
-        self.publish_diagnostics(0 if not missing else 1,
-                                 f'recording to {self.path}: {total} messages'
-                                 + (f'; waiting for {", ".join(missing)}' if missing else ''),
-                                 {'messages': total, 'path': str(self.path)})
+        missing = [t for t in self._wanted if t not in self.counts]
+        text = f'recording to {self.path}: {total} messages'
+        text += f'; waiting for {", ".join(missing)}' if missing else ''
+        text += ''.join(f'; NOT recorded: {k}: {why}' for k, why in self.not_recorded.items())
+        level = 2 if self._unrecordable else 1 if missing else 0
+        self.publish_diagnostics(level, text, {'messages': total, 'path': str(self.path)})
 
     def close(self) -> None:
         """Finalise the bag (summary, metadata.yaml); idempotent."""

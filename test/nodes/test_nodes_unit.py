@@ -30,6 +30,7 @@ rclpy = pytest.importorskip('rclpy')
 
 from rclpy.node import Node  # noqa: E402
 from rclpy.parameter import Parameter  # noqa: E402
+from rclpy.qos import QoSProfile, ReliabilityPolicy  # noqa: E402
 from std_msgs.msg import Float64, String  # noqa: E402
 
 from hyst_id.compensation.params_file import (  # noqa: E402
@@ -589,3 +590,44 @@ def test_a_push_to_an_invalid_node_name_is_logged_and_dropped(ctx, monkeypatch):
     pusher.poll()
     assert said and 'cannot push the parameters to bad name!' in said[0]
     assert pusher._pending is None
+
+
+def test_recorder_follows_a_best_effort_publisher_and_names_a_second_type(ctx, tmp_path):
+    """A best-effort publisher joining a reliable one is recorded; a second type is an ERROR.
+
+    Before, the recorder kept the first QoS and type it saw: every message of a
+    best-effort publisher joining a reliable one, and a Float64 stream after a String
+    publisher, were lost without a word (found by an independent review). Fast DDS
+    takes one type per topic in a process, so the second type is named, not recorded.
+    """
+    rec = _make(ctx, Recorder, parameter_overrides=[
+        Parameter('output', value=str(tmp_path / 'bag')),
+        Parameter('topics', value=['/mixed', '/joined'])])
+    talker = _make(ctx, Node, 'talker')
+    text = talker.create_publisher(String, '/mixed', 10)
+    reliable = talker.create_publisher(Float64, '/joined', 10)
+    assert _spin_until(ctx, [rec, talker], lambda: {'/mixed', '/joined'} <= set(rec.subscribed))
+    other = rclpy.Context()      # one participant cannot publish two types on a topic
+    rclpy.init(context=other)
+    try:
+        stranger = Node('stranger', context=other)
+        stranger.create_publisher(Float64, '/mixed', 10)
+        best = QoSProfile(depth=10, reliability=ReliabilityPolicy.BEST_EFFORT)
+        loose = talker.create_publisher(Float64, '/joined', best)
+        assert _spin_until(ctx, [rec, talker], lambda: loose.get_subscription_count() > 0
+                           and rec.not_recorded, timeout=15.0), rec.not_recorded
+        assert list(rec.not_recorded) == ['/mixed (std_msgs/msg/Float64)']
+        assert 'one type per topic' in rec.not_recorded['/mixed (std_msgs/msg/Float64)']
+        text.publish(String(data='hello'))
+        for k in range(10):
+            reliable.publish(Float64(data=100.0 + k))
+            loose.publish(Float64(data=200.0 + k))
+        assert _spin_until(ctx, [rec, talker], lambda: rec.counts['/mixed'] == 1
+                           and rec.counts['/joined'] == 20), rec.counts
+        stranger.destroy_node()
+    finally:
+        other.try_shutdown()
+    rec.close()
+    rows = list(iter_bag_messages(tmp_path / 'bag', topics=['/joined']))
+    assert sorted(m.data for _, _, _, m in rows) == [100.0 + k for k in range(10)] + [
+        200.0 + k for k in range(10)]
