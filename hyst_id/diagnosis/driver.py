@@ -221,7 +221,7 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
                   command_unit=rec.command_unit, measurement_unit=rec.measurement_unit,
                   measurement_name=rec.measurement_name,
                   extra={'period_s': period_s(t[:n_train], v[:n_train])})
-    sigma = noise_std(y)
+    sigma = noise_std(y) or 1e-12 * float(np.max(np.abs(y)))    # noise-free: no 0 floor
     data = Data(t_s=t, v=v, y=y, n_train=n_train, noise_std=sigma,
                 judged=inside_rows(v, n_train))
     say(f'baseline: identify (GAASS x {len(settings.seeds)} seeds, global phase) twice on the '

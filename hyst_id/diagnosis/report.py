@@ -24,7 +24,12 @@ import numpy as np
 from hyst_id.diagnosis.blocked_cv import confirmed, summary as cv_summary
 from hyst_id.io.outputs import names_folder
 
-__all__ = ['format_diagnosis', 'plot_diagnosis', 'unknown_reading']
+__all__ = ['format_diagnosis', 'over', 'plot_diagnosis', 'unknown_reading']
+
+
+def over(value: float, floor: float) -> float:
+    """``value / floor``, infinite for a floor of 0 (a noise-free record) instead of raising."""
+    return float(value) / float(floor) if floor > 0 else float('inf')
 
 
 def _fmt(x: float) -> str:
@@ -162,13 +167,13 @@ def unknown_reading(heldout_x: float, train_x: float, whole_x: float | None,
 def _unknown_lines(d: Any) -> list[str]:
     """:func:`unknown_reading` from a diagnosis."""
     w = d.extra.get('whole_record')
-    whole = w['er_percent'] / w['noise_floor_percent'] if w else None
+    whole = over(w['er_percent'], w['noise_floor_percent']) if w else None
     floor_t = d.noise_floor_train_percent
     last = d.rounds[-1]['candidates'] if d.rounds else []
-    train_only = [(c['mechanism'], c['er_train_percent'] / floor_t) for c in last
+    train_only = [(c['mechanism'], over(c['er_train_percent'], floor_t)) for c in last
                   if c['status'] == 'training only']
-    return unknown_reading(d.final.er_holdout_percent / d.noise_floor_percent,
-                           d.final.er_train_percent / floor_t, whole,
+    return unknown_reading(over(d.final.er_holdout_percent, d.noise_floor_percent),
+                           over(d.final.er_train_percent, floor_t), whole,
                            sorted(train_only, key=lambda z: z[1]))
 
 
@@ -216,32 +221,32 @@ def format_diagnosis(d: Any) -> str:
                          'command and at the noise floor on held-out data: this record shows no '
                          'physics that the model leaves out.')
         elif d.verdict == 'unknown':
-            ratio = d.final.er_holdout_percent / d.noise_floor_percent
+            ratio = over(d.final.er_holdout_percent, d.noise_floor_percent)
             lines.append('verdict: unknown - the model misses something '
                          f'({ratio:.2f} x the noise floor on held-out data) and no mechanism '
                          'of the library explains it (table below); where it shows is above.')
             lines += [f'  - {x}' for x in _unknown_lines(d)]
             lines += _withdrawn_lines(d)
         elif 'whole_record' in d.extra:
-            ratio = d.final.er_holdout_percent / d.noise_floor_percent
+            ratio = over(d.final.er_holdout_percent, d.noise_floor_percent)
             w = d.extra['whole_record']
             lines.append(f'verdict: none - the held-out part is missed ({ratio:.2f} x the '
                          'noise floor) and no mechanism of the library explains it, but the '
                          'same chain identified on the whole record makes it at '
-                         f'{w["er_percent"] / w["noise_floor_percent"]:.2f} x its floor: '
+                         f'{over(w["er_percent"], w["noise_floor_percent"]):.2f} x its floor: '
                          'nothing the data show is missing from the model. The training part '
                          'did not pin the chain down (the held-out command goes where the '
                          "training's did not, along the loop); judged on this split alone "
                          'the question is undecided.')
             lines += _withdrawn_lines(d)
         elif d.extra.get('withdrawn'):
-            ratio = d.final.er_holdout_percent / d.noise_floor_percent
+            ratio = over(d.final.er_holdout_percent, d.noise_floor_percent)
             detail = f'{ratio:.2f} x the noise floor on held-out data'
             lines.append(f"verdict: none - {_withdrawn_clause(d.extra['withdrawn'], detail)}. "
                          'The baseline had stopped short of its basin, and no physics is '
                          'missing.')
         else:
-            ratio = d.final.er_holdout_percent / d.noise_floor_percent
+            ratio = over(d.final.er_holdout_percent, d.noise_floor_percent)
             lines.append('verdict: none - no mechanism of the library improves the held-out '
                          'error significantly (table below). The remaining mismatch '
                          f'({ratio:.2f} x the noise floor on held-out data) is within what '
@@ -280,7 +285,7 @@ def format_diagnosis(d: Any) -> str:
         lines.append('')
     if d.findings:
         fin = d.final
-        ratio = fin.er_holdout_percent / d.noise_floor_percent
+        ratio = over(fin.er_holdout_percent, d.noise_floor_percent)
         lines.append(f'final model: baseline + {" + ".join(fin.ids)}: %e_r train '
                      f'{_fmt(fin.er_train_percent)}, held-out {_fmt(fin.er_holdout_percent)} '
                      f'= {ratio:.2f} x the noise floor')
@@ -289,7 +294,7 @@ def format_diagnosis(d: Any) -> str:
             lines.append(f'judged on the first {j["n_samples"]} of {j["n_holdout"]} held-out '
                          'samples (before the command leaves the training range): %e_r '
                          f'{_fmt(j["baseline_er_percent"])} -> {_fmt(j["final_er_percent"])} '
-                         f'= {j["final_er_percent"] / j["noise_floor_percent"]:.2f} x the '
+                         f'= {over(j["final_er_percent"], j["noise_floor_percent"]):.2f} x the '
                          'noise floor there')
         if 'blocked_cv' in d.extra:
             lines.append(f'final model against the baseline: {cv_summary(d.extra["blocked_cv"])}')

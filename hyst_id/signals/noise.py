@@ -42,7 +42,7 @@ from math import comb
 import numpy as np
 
 __all__ = ['estimate_noise_std', 'floor_percent', 'held_share', 'noise_floor_percent',
-           'quantum', 'REPEAT_TOLERANCE', 'robust_noise_std']
+           'quantum', 'REPEAT_TOLERANCE', 'robust_noise_std', 'STUCK_SHARE']
 
 #: Steps below this share of the signal's magnitude count as repeats: a value written
 #: through a unit conversion, or perturbed at round-off level, is still the same A/D count.
@@ -91,6 +91,21 @@ def estimate_noise_std(measurement: np.ndarray) -> float:
 
 def _repeat_tolerance(y: np.ndarray) -> float:
     return REPEAT_TOLERANCE * float(np.max(np.abs(y))) if y.size else 0.0
+
+
+#: Share of repeated samples above which :func:`robust_noise_std` leaves the repeats out
+#: (when the values are not quantised): a reading stuck at a clip or end stop on 62 % of
+#: a record gave a noise of 0, and the diagnosis divided by that floor.
+STUCK_SHARE = 0.2
+
+
+def _in_repeat_runs(y: np.ndarray) -> np.ndarray:
+    """Whether each sample repeats a neighbour (to round-off)."""
+    rep = np.abs(np.diff(y)) <= _repeat_tolerance(y)
+    out = np.zeros(y.size, dtype=bool)
+    out[1:] |= rep
+    out[:-1] |= rep
+    return out
 
 
 def held_share(measurement: np.ndarray) -> float:
@@ -166,9 +181,15 @@ def robust_noise_std(measurement: np.ndarray) -> float:
     if q > 0:
         y = y + np.random.default_rng(0).uniform(-0.5 * q, 0.5 * q, y.size)
         extra = q * q / 12.0
+    # a reading stuck for a fifth of the record or more (a clip, an end stop, a dead
+    # stretch) carries no noise there: its differences are left out
+    free = ~_in_repeat_runs(y) if q == 0 and held_share(y) > STUCK_SHARE else None
     est = []
     for order, norm in ((1, 2.0), (2, 6.0), (3, 20.0)):
         d = np.diff(y, n=order)
+        if free is not None:
+            whole = np.convolve(free, np.ones(order + 1), 'valid') == order + 1
+            d = d[whole] if np.count_nonzero(whole) >= 8 else d
         if d.size < 8:
             continue
         mad = float(np.median(np.abs(d - np.median(d))))

@@ -23,7 +23,7 @@ import pytest
 
 from hyst_id.rig import load_rig_params, simulate_rig
 from hyst_id.signals.excitation import eq24
-from hyst_id.signals.noise import estimate_noise_std, noise_floor_percent
+from hyst_id.signals.noise import estimate_noise_std, noise_floor_percent, robust_noise_std
 
 PIPELINE = Path(__file__).resolve().parents[2] / 'params' / 'pipeline.yaml'
 
@@ -78,3 +78,22 @@ def test_quantised_data_read_the_same_after_round_off(probe_seed):
     assert quantum(y_probed) == pytest.approx(q, rel=1e-6)
     assert noise_std(y_probed) == pytest.approx(noise_std(y), rel=1e-6)
     assert estimate_noise_std(y_probed) == pytest.approx(estimate_noise_std(y), rel=1e-6)
+
+
+@pytest.mark.parametrize('seed', [0, 1, 2])
+@pytest.mark.parametrize('stuck', [0.3, 0.62, 0.9])
+def test_a_reading_stuck_at_a_clip_keeps_its_noise(seed, stuck):
+    """A clip holding a share of the record leaves the noise of the rest (it gave 0).
+
+    A new user's pressure reading clipped at 7.0 on 62 % of its samples gave a noise
+    of 0, and the diagnosis divided by that floor (found by an independent review).
+    """
+    rng = np.random.default_rng(seed)
+    t = np.arange(3000) * 0.02
+    clean = np.sin(2 * np.pi * t / 12.0)
+    level = float(np.quantile(clean, 1.0 - stuck))
+    y = np.minimum(clean + rng.normal(0.0, 0.01, t.size), level)
+    assert np.mean(y == level) > stuck - 0.1
+    # seeds 0-4: 0.0094-0.0103 at 30 % and 62 % stuck; 0.0079-0.0106 at 90 % (the free
+    # samples left are few and near the clip, which cuts their noise)
+    assert robust_noise_std(y) == pytest.approx(0.01, rel=0.1 if stuck < 0.9 else 0.3)
