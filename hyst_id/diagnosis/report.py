@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from hyst_id.diagnosis.blocked_cv import confirmed, summary as cv_summary
+from hyst_id.identification.quality import response_warnings
 from hyst_id.io.outputs import names_folder
 
 __all__ = ['format_diagnosis', 'over', 'plot_diagnosis', 'unknown_reading']
@@ -210,6 +211,8 @@ def format_diagnosis(d: Any) -> str:
                  f'{_fmt(d.baseline.er_holdout_percent)}; noise floor '
                  f'{_fmt(d.noise_floor_percent)} held-out / {_fmt(d.noise_floor_train_percent)} '
                  f'train (noise std {d.noise_std:.3g}{" " + unit if unit else ""})')
+    y_train = (d.baseline.prediction + d.baseline.residual)[:nt]
+    lines += [f'warning: {w}' for w in response_warnings(d.baseline.er_train_percent, y_train)]
     loop_words = d.measured_loop.words(d.measurement_name or 'measurement', unit)
     lines.append(f'{loop_words} (from the data alone)')
     lines += ['', 'where the baseline departs from the measurement:']

@@ -59,7 +59,9 @@ __all__ = [
     'UNDER_FLOOR',
     'assess',
     'domain_edge_warnings',
+    'explained_share',
     'fit_warnings',
+    'FOLLOWS_SHARE',
     'floor_estimate_warnings',
     'floor_says_nothing',
     'identification_warnings',
@@ -67,6 +69,7 @@ __all__ = [
     'parameter_scales',
     'poorly_determined',
     'poorly_determined_warnings',
+    'response_warnings',
     'unexcited_warnings',
 ]
 
@@ -78,6 +81,9 @@ NOISE_FREE_RATIO = 1000.0
 #: A fit below this share of its noise floor (after what fitting the parameters takes
 #: off the noise) says the floor was estimated too high.
 UNDER_FLOOR = 0.8
+#: A fit explaining less than this share of the measurement's variance says the
+#: measurement does not follow the command (:func:`response_warnings`).
+FOLLOWS_SHARE = 0.1
 #: Seeds within this factor of the best %e_r count as converged.
 CONVERGED_FACTOR = 1.1
 #: Relative spread or standard error above which a parameter is poorly determined.
@@ -130,7 +136,8 @@ def assess(ident: Identification, rec: Recording,
     """
     if spec is None:
         spec = replace(ident.spec(), calibration=None)
-    out = orientation_warnings(rec, _sign(ident))
+    out = response_warnings(ident.er_percent, rec.measurement)
+    out += orientation_warnings(rec, _sign(ident))
     out += fit_warnings(ident) + floor_estimate_warnings(ident, rec.n_samples)
     out += domain_edge_warnings(ident, rec, spec)
     unexcited, names = unexcited_warnings(ident, rec)
@@ -138,6 +145,34 @@ def assess(ident: Identification, rec: Recording,
     poor = poorly_determined(ident, rec, skip=names)
     out += _poor_warning(poor)
     return out, {name: rel for name, (rel, _) in sorted(poor.items())}
+
+
+def explained_share(er_percent: float, measurement: np.ndarray) -> float:
+    """Share of the measurement's variance about its mean that a fit of ``er_percent`` explains.
+
+    %e_r (Eq. 7) is relative to the measurement itself; its mean alone
+    (a constant model) gives ``100 sqrt(var / mean square)``.
+    """
+    y = np.asarray(measurement, dtype=float)
+    var, mean_square = float(np.var(y)), float(np.mean(y * y))
+    if not var > 0.0:
+        return 1.0
+    return 1.0 - (er_percent / 100.0) ** 2 * mean_square / var
+
+
+def response_warnings(er_percent: float, measurement: np.ndarray) -> list[str]:
+    """Warn when the fit explains almost none of the measurement: it does not follow the command.
+
+    A disconnected sensor reading noise, or the wrong column, is fitted by a flat
+    chain at ``1.00 x`` a noise floor estimated from the measurement itself.
+    """
+    share = explained_share(er_percent, measurement)
+    if share >= FOLLOWS_SHARE:
+        return []
+    return [f"the model explains {100 * max(share, 0.0):.1f} % of the measurement's "
+            'variation: the measurement does not follow the command (a disconnected or wrong '
+            'sensor, the wrong column, or no response). The noise floor is estimated from the '
+            "measurement's own sample-to-sample changes, so a ratio to it means nothing here"]
 
 
 def orientation_warnings(rec: Recording, sign: float = 1.0) -> list[str]:

@@ -275,3 +275,25 @@ def test_smooth_loop_is_not_flagged():
     assert loop_orientation(rec.command, rec.measurement) < -0.05     # counter-clockwise
     assert orientation_warnings(rec) == []
     assert steepest_slope(rec) < 5.0
+
+
+@pytest.mark.parametrize('seed', [0, 1, 2])
+def test_a_measurement_that_does_not_follow_the_command_is_said_so(seed):
+    """A disconnected sensor (noise) fitted at '1.00 x the floor' is named, a response is not.
+
+    A new user's pure-noise measurement was reported as a fit at the noise floor with a
+    loop's parameters (found by an independent review): the floor comes from the
+    measurement's own differences, so for noise the ratio means nothing.
+    """
+    from hyst_id.identification.quality import explained_share, response_warnings
+    rng = np.random.default_rng(seed)
+    t = np.arange(2000) * 0.05
+    v = 10.0 + 8.0 * np.sin(2 * np.pi * 0.1 * t)
+    noise = rng.standard_normal(t.size)
+    flat = 100.0 * np.sqrt(np.mean((noise - noise.mean()) ** 2) / np.mean(noise ** 2))
+    assert explained_share(flat, noise) == pytest.approx(0.0, abs=1e-9)
+    words = response_warnings(0.999 * flat, noise)
+    assert len(words) == 1 and 'does not follow the command' in words[0]
+    follows = 0.5 * v + 3.0 + rng.normal(0.0, 0.5, t.size)     # signal std 2.8 x the noise
+    fit = 100.0 * np.sqrt(np.mean((follows - 0.5 * v - 3.0) ** 2) / np.mean(follows ** 2))
+    assert response_warnings(fit, follows) == []
