@@ -26,6 +26,7 @@ __all__ = [
     'HystIdError',
     'RecordingError',
     'MissingTopicError',
+    'TruncatedBagError',
     'NoExcitationError',
     'ConfigError',
     'InfeasibleBoundsError',
@@ -42,6 +43,10 @@ class HystIdError(Exception):
 
 class RecordingError(HystIdError):
     """A recording cannot be read or fails validation (NaN, time order...)."""
+
+
+class TruncatedBagError(RecordingError):
+    """An MCAP bag has no footer (its recorder was killed): its complete chunks can be read."""
 
 
 class MissingTopicError(RecordingError):

@@ -21,7 +21,7 @@ from pathlib import Path
 import sys
 from typing import Any
 
-from hyst_id.errors import ConfigError
+from hyst_id.errors import ConfigError, TruncatedBagError
 from hyst_id.identification import config, IdentifySettings
 from hyst_id.identification.chains import CHAIN_NAMES, ChainSpec
 from hyst_id.io.outputs import make_output_folder, names_folder
@@ -119,8 +119,14 @@ def load_recording(args: argparse.Namespace) -> Recording:
         print(f'note: {args.params}: only topics and fields are read here; node parameters '
               f'{", ".join(unused[:8])}{" ..." if len(unused) > 8 else ""} are not used (give '
               'GAASS settings and domains as flags)', file=sys.stderr)
-    rec = read_recording(args.recording, args.channel, topics=topics,
-                         columns=parse_columns(args.columns), time_scale=args.time_scale)
+    how = {'topics': topics, 'columns': parse_columns(args.columns), 'time_scale': args.time_scale}
+    try:
+        rec = read_recording(args.recording, args.channel, **how)
+    except TruncatedBagError:           # a killed recorder's bag: its complete chunks
+        print(f'note: {args.recording} has no MCAP footer (its recorder was killed or the '
+              'file was cut): reading its complete chunks; what the recorder held in memory '
+              'when it stopped (up to about a second) is not in the file', file=sys.stderr)
+        rec = read_recording(args.recording, args.channel, recover_truncated=True, **how)
     for note in time_unit_notes(rec.notes) + [gap_note(rec.t_s)]:
         if note:
             print(f'note: {note}', file=sys.stderr)

@@ -39,7 +39,7 @@ from pathlib import Path
 import time
 from typing import Any, Callable, Iterable
 
-from hyst_id.errors import ConfigError, HystIdError
+from hyst_id.errors import ConfigError, HystIdError, TruncatedBagError
 from hyst_id.identification.workers import map_in_processes, n_processes
 
 __all__ = ['FleetOptions', 'find_recordings', 'fleet_task', 'result_path', 'run_fleet']
@@ -123,9 +123,12 @@ def fleet_task(path: str, options: FleetOptions) -> dict:
         from hyst_id.io.readers import CSV_SUFFIXES, read_recording
 
         csv = Path(path).suffix.lower() in CSV_SUFFIXES     # columns are a CSV's only
-        rec = read_recording(path, options.channel, topics=options.topics or None,
-                             columns=options.columns if csv else None,
-                             time_scale=options.time_scale if csv else None)
+        how = {'topics': options.topics or None, 'columns': options.columns if csv else None,
+               'time_scale': options.time_scale if csv else None}
+        try:
+            rec = read_recording(path, options.channel, **how)
+        except TruncatedBagError:   # a killed recorder's bag: its complete chunks (noted)
+            rec = read_recording(path, options.channel, recover_truncated=True, **how)
         spec = make_spec(rec, 'auto', family=options.model)
         settings = make_settings(seeds=options.seeds, generations=options.generations,
                                  workers=1)

@@ -71,7 +71,7 @@ from rosbags.typesys import (
     TypesysError,
 )
 
-from hyst_id.errors import ConfigError, MissingTopicError, RecordingError
+from hyst_id.errors import ConfigError, MissingTopicError, RecordingError, TruncatedBagError
 from hyst_id.io.bag_metadata import fix_metadata, rosbags_qos
 from hyst_id.io.interface_types import register_interface_types
 from hyst_id.io.mcap_recover import lacks_footer, scan_records
@@ -377,7 +377,7 @@ def open_bag(path: str | Path, *, recover_truncated: bool = False) -> Iterator[B
             if recover_truncated:
                 yield _recover(mcaps[0], path, notes)
                 return
-            raise RecordingError(
+            raise TruncatedBagError(
                 f'cannot read bag {path}: {failure} (no MCAP footer: truncated, or the '
                 f'recorder was killed; recover_truncated=True reads its complete chunks)')
         raise RecordingError(f'cannot read bag {path}: {failure}')
