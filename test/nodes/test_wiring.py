@@ -35,6 +35,7 @@ rclpy = pytest.importorskip('rclpy')
 from diagnostic_msgs.msg import DiagnosticArray  # noqa: E402, I100
 from rclpy.node import Node  # noqa: E402
 from rclpy.parameter import Parameter  # noqa: E402
+from rclpy.qos import QoSProfile, ReliabilityPolicy  # noqa: E402
 from std_msgs.msg import Float64, String  # noqa: E402
 from test_identifier_node import _feed, _samples, FAST, PAPER  # noqa: E402
 
@@ -182,6 +183,23 @@ def test_a_wrong_message_type_on_the_desired_topic_is_an_error(ctx):
         assert _spin_until(ctx, lambda: any(n == 'hyst_id: compensator' and lvl == 2
                                             and 'std_msgs/msg/String' in m
                                             for n, lvl, m in statuses), timeout=10.0)
+
+
+def test_a_best_effort_publisher_on_the_reliable_desired_topic_is_an_error(ctx):
+    """A publisher whose QoS the subscription does not match is named, not silence.
+
+    The compensator stayed OK "compensating" while a best-effort publisher's desired
+    values never reached it (found by an independent review).
+    """
+    statuses = _statuses(ctx)
+    make_node(ctx, Compensator, parameter_overrides=[
+        Parameter('diagnostics_period_s', value=0.2)])
+    io = make_node(ctx, Node, 'loose')
+    io.create_publisher(Float64, 'hyst_id/desired',
+                        QoSProfile(depth=10, reliability=ReliabilityPolicy.BEST_EFFORT))
+    assert _spin_until(ctx, lambda: any(n == 'hyst_id: compensator' and lvl == 2
+                                        and '/loose publishes best effort' in m
+                                        for n, lvl, m in statuses), timeout=10.0)
 
 
 def test_commands_without_measurements_are_an_error(ctx):

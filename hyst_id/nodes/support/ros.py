@@ -35,13 +35,14 @@ from rclpy.exceptions import ParameterNotDeclaredException
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, ReliabilityPolicy
 from rclpy.signals import SignalHandlerOptions
 
 from hyst_id.errors import ConfigError, HystIdError
 
 __all__ = ['EXIT_SIGINT', 'check_field', 'diagnostic_array', 'exit_code_after', 'first_line',
            'init_ros',
-           'input_problems', 'message_class', 'resolved', 'source_time_ns',
+           'input_problems', 'message_class', 'qos_mismatch', 'resolved', 'source_time_ns',
            'spin_in_background', 'spin_node', 'spin_until_stopped', 'stamp_ns', 'stop_signals',
            'try_publish', 'type_mismatches']
 
@@ -229,19 +230,46 @@ def diagnostic_array(node: Node, name: str, level: int | bytes, message: str,
 
 
 def type_mismatches(node: Node, topic: str, expected: str) -> list[str]:
-    """Publishers on ``topic`` whose message type is not ``expected``, in words.
+    """Publishers on ``topic`` this node never hears from, in words: wrong type or QoS.
 
     ``topic`` may be relative (the node's namespace and remaps apply);
     ``expected`` is a full type name such as ``std_msgs/msg/Float64``. A
-    subscriber never receives what such a publisher sends (the middleware
-    does not match them), so without this check a wrong type is silence.
+    subscriber never receives what a publisher of another type sends, nor
+    what a best-effort publisher sends to its reliable subscription, nor a
+    volatile publisher to its transient-local one (the middleware does not
+    match them), so without this check either is silence.
     """
     try:
-        infos = node.get_publishers_info_by_topic(node.resolve_topic_name(topic))
+        name = node.resolve_topic_name(topic)
+        infos = node.get_publishers_info_by_topic(name)
+        mine = [i.qos_profile for i in node.get_subscriptions_info_by_topic(name)
+                if i.node_name == node.get_name()
+                and i.node_namespace == node.get_namespace()]
     except Exception:  # noqa: BLE001 - a graph query must never stop the node
         return []
-    return sorted({f'{(i.node_namespace.rstrip("/") + "/" + i.node_name)} publishes '
-                   f'{i.topic_type}' for i in infos if i.topic_type != expected})
+    out = set()
+    for i in infos:
+        who = i.node_namespace.rstrip('/') + '/' + i.node_name
+        if i.topic_type != expected:
+            out.add(f'{who} publishes {i.topic_type}')
+            continue
+        for sub in mine:
+            why = qos_mismatch(sub, i.qos_profile)
+            if why:
+                out.add(f'{who} publishes {why}')
+    return sorted(out)
+
+
+def qos_mismatch(sub: Any, pub: Any) -> str:
+    """Why a publisher's QoS ``pub`` does not reach a subscription's ``sub`` ('' if it does)."""
+    if (sub.reliability == ReliabilityPolicy.RELIABLE
+            and pub.reliability == ReliabilityPolicy.BEST_EFFORT):
+        return ('best effort to this reliable subscription (QoS incompatible: make the '
+                "publisher reliable, or override this subscription's reliability)")
+    if (sub.durability == DurabilityPolicy.TRANSIENT_LOCAL
+            and pub.durability == DurabilityPolicy.VOLATILE):
+        return 'volatile to this transient-local (latched) subscription (QoS incompatible)'
+    return ''
 
 
 def input_problems(node: Node, expected: Sequence[tuple[str, str]], rx: Mapping[str, float],
