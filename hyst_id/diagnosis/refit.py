@@ -56,12 +56,14 @@ from __future__ import annotations
 import numpy as np
 
 from hyst_id.diagnosis.baseline import baseline_starts
+from hyst_id.diagnosis.mechanisms.registry import MECHANISMS
 from hyst_id.diagnosis.select import evaluate, FitResult, polish
 from hyst_id.errors import IdentificationError, RecordingError
 from hyst_id.identification.chains import ChainSpec
 from hyst_id.io.recording import Recording
 
-__all__ = ['CONTEST_ABOVE', 'CONTEST_RATIO', 'CONTESTANTS', 'contest', 'REFIT_ABOVE',
+__all__ = ['CONTEST_ABOVE', 'CONTEST_RATIO', 'CONTESTANTS', 'contest', 'implausible_after',
+           'REFIT_ABOVE',
            'reidentify', 'undone_record']
 
 #: A fit within this factor of the training noise floor is not re-identified.
@@ -168,6 +170,21 @@ def _reidentify_once(fit: FitResult, data, ctx, spec: ChainSpec, settings,
     return evaluate(model, data, best[0], fit.nfev + best[2])
 
 
+def implausible_after(comp, data, ctx) -> str:
+    """Why ``comp``'s block, in its re-identified fit, cannot be what the data show ('').
+
+    The trial judged the block on its local fit; re-identified with the chain its
+    values can move where the physics cannot go (a new user's Bouc-Wen record: a
+    creep relaxing back by 110 % of the travel took the round this way).
+    """
+    fit = comp.fit
+    mech = MECHANISMS.get(comp.mechanism)
+    if mech is None or fit.model is None or mech.id not in fit.model.slices:
+        return ''
+    return mech.implausible(fit.model.theta(fit.p, mech.id), fit.coef, fit.span,
+                            data.noise_std, ctx, fit.labels)
+
+
 def contest(winner, comps: list, data, ctx, spec: ChainSpec, settings, *,
             floor_train_percent: float, say=None, beats=None) -> tuple:
     """The round's winner re-identified, or a runner-up whose re-identified chain beats it.
@@ -221,6 +238,10 @@ def contest(winner, comps: list, data, ctx, spec: ChainSpec, settings, *,
                            floor_train_percent=floor_train_percent)
         er = data.judged_er_percent(c.fit)
         record.append({'mechanism': c.mechanism, 'er_judged_after_percent': er})
+        why = implausible_after(c, data, ctx)
+        if why:     # re-identified into values its physics cannot have: it cannot take the round
+            record[-1]['implausible'] = why
+            continue
         if beats is None:
             if er * settings.criteria.tie_ratio < data.judged_er_percent(chosen.fit):
                 chosen = c

@@ -84,4 +84,28 @@ def test_a_slow_share_above_the_whole_travel_is_refused():
     assert creep.implausible(theta, np.array([0.8, 0.2, 0.0]), span, 0.01, None, labels) == ''
     # relaxing back (a negative share) is creep too
     assert creep.implausible(theta, np.array([1.2, -0.2, 0.0]), span, 0.01, None, labels) == ''
+    # ... but not back by more than the whole travel (a Bouc-Wen record got -110 %)
+    reason = creep.implausible(theta, np.array([2.1, -1.1, 0.0]), span, 0.01, None, labels)
+    assert 'relax back by more than the whole travel' in reason and '-110 %' in reason
     assert creep.implausible(theta, np.array([-0.33, 1.33, 0.0]), span, 0.01) == ''
+
+
+def test_a_contestant_re_identified_into_impossible_creep_cannot_take_the_round():
+    """The contest checks a re-identified block's plausibility, as the trial did.
+
+    A new user's rate-independent Bouc-Wen record was given ``creep`` relaxing back by
+    110 % of the travel: re-identified with the chain, the block's share moved where
+    the trial would have refused it (found by an independent review).
+    """
+    from types import SimpleNamespace
+    from hyst_id.diagnosis.refit import implausible_after
+    labels = ['sensor', 'creep:0', 'offset']
+    model = SimpleNamespace(slices={'creep': slice(11, 12)},
+                            theta=lambda p, mid: np.asarray(p[11:12]))
+    fit = SimpleNamespace(model=model, p=np.r_[np.zeros(11), 16.5], span=(0.0, 1.0),
+                          labels=labels, coef=np.array([2.1, -1.1, 0.0]))
+    data = SimpleNamespace(noise_std=0.01)
+    comp = SimpleNamespace(mechanism='creep', fit=fit)
+    assert 'more than the whole travel' in implausible_after(comp, data, None)
+    fit.coef = np.array([0.9, 0.1, 0.0])
+    assert implausible_after(comp, data, None) == ''

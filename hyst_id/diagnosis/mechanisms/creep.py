@@ -92,12 +92,19 @@ class Creep(Mechanism):
         and the slow part overshoots it: a travel that first goes the wrong
         way. On the blind family's #128 (second-order actuator dynamics and a
         sensor lag, no creep) the block took round 1 with a 133 % share and
-        the sensor lag's time constant (bench/blind_family.py).
+        the sensor lag's time constant (bench/blind_family.py). Relaxing back by
+        more than the whole travel (``c < -1``) is refused too: a new user's
+        rate-independent Bouc-Wen record was given ``creep`` relaxing back by
+        110 % of the travel in 16.5 s (found by an independent review).
         """
         share = _share(coef, labels)
         if share > 1.0:
             return (f'slow share {100.0 * share:.0f} % is more than the whole travel: the fast '
                     'part would move against the command; a lag of the whole response, not creep')
+        if share < -1.0:
+            return (f'slow share {100.0 * share:.0f} %: the travel would first overshoot to '
+                    f'{100.0 * (1.0 - share):.0f} % of its final value and relax back by more '
+                    'than the whole travel; not creep')
         return ''
 
     def describe(self, theta, coef, info, ctx) -> dict[str, Quantity]:
