@@ -47,6 +47,7 @@ from hyst_id.nodes.support import (
     HystNode,
     OVERRIDABLE,
     Param,
+    resolved,
     scalar_type_param,
     ScalarStream,
     SENSOR_QOS,
@@ -170,8 +171,9 @@ class ActuatorDriver(HystNode):
                                  COMMAND_QOS, qos_overriding_options=OVERRIDABLE)
         self.watch_input_types([(self.p('topics.command_topic'), self._command.type_name)])
         self.get_logger().info(
-            f'{type(actuator).__name__}: {self.p("topics.command_topic")} -> '
-            f'{self.p("topics.position_topic")} (joint {self.p("joint_name")!r})')
+            f'{type(actuator).__name__}: {resolved(self, self.p("topics.command_topic"))} -> '
+            f'{resolved(self, self.p("topics.position_topic"))} '
+            f'(joint {self.p("joint_name")!r})')
 
     def validate_params(self, values: dict[str, Any], changed: set[str]) -> str | None:
         if changed & set(_H_NAMES + _B_NAMES):

@@ -44,6 +44,7 @@ from hyst_id.nodes.support import (
     HystNode,
     OVERRIDABLE,
     Param,
+    resolved,
     scalar_type_param,
     ScalarStream,
     spin_node,
@@ -187,8 +188,9 @@ class Excitation(HystNode):
         now = self.get_clock().now().nanoseconds * 1e-9
         if have < need:
             if self._state != 'waiting':
-                self.get_logger().info(f'waiting for {need} subscriber(s) on '
-                                       f'{self.p("topics.output_topic")} (have {have})')
+                topic = resolved(self, self.p('topics.output_topic'))
+                self.get_logger().info(f'waiting for {need} subscriber(s) on {topic} '
+                                       f'(have {have})')
                 self._state = 'waiting'
             self._wait_since = None
             return
@@ -211,7 +213,8 @@ class Excitation(HystNode):
         self._state = 'running'
         period = self.p('sample_period_s') / self.p('time_scale')
         self.get_logger().info(
-            f'{self.p("profile")} on {self.p("topics.output_topic")}: {self._n_samples} '
+            f'{self.p("profile")} on {resolved(self, self.p("topics.output_topic"))}: '
+            f'{self._n_samples} '
             f'samples every {self.p("sample_period_s"):g} s of profile time '
             f'({period * 1e3:.3g} ms wall clock, time_scale {self.p("time_scale"):g})')
         self._tick()

@@ -437,7 +437,7 @@ class Identifier(HystNode):
     def _publish_diagnosis(self, doc: dict, elapsed_s: float) -> None:
         self.last_diagnosis = doc
         self._diag_json_pub.publish(String(data=json.dumps(doc)))
-        prefix = f'hyst_id: {self.get_name()}: diagnosis'
+        prefix = f'hyst_id: {self.status_name}: diagnosis'
         self._diag_statuses = [
             diagnostic_array(self, f'{prefix}: {name}', level, message, values).status[0]
             for level, name, message, values in diagnosis_statuses(doc)]

@@ -66,6 +66,7 @@ from hyst_id.nodes.support import (
     HystNode,
     OVERRIDABLE,
     Param,
+    resolved,
     scalar_type_param,
     ScalarStream,
     SENSOR_QOS,
@@ -260,8 +261,9 @@ class PipelineSim(HystNode):
         outs = [values['topics.pressure_topic'], values['topics.flow_topic']]
         if self._pos_pub is not None:
             outs.append(values['topics.position_topic'])
-        self.get_logger().info(f'{type(self.plant).__name__}: {values["topics.command_topic"]}'
-                               f' -> {", ".join(outs)}')
+        self.get_logger().info(f'{type(self.plant).__name__}: '
+                               f'{resolved(self, values["topics.command_topic"])} -> '
+                               + ', '.join(resolved(self, o) for o in outs))
 
     def validate_params(self, values: dict[str, Any], changed: set[str]) -> str | None:
         return actuator_problem(values)

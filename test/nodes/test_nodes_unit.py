@@ -631,3 +631,9 @@ def test_recorder_follows_a_best_effort_publisher_and_names_a_second_type(ctx, t
     rows = list(iter_bag_messages(tmp_path / 'bag', topics=['/joined']))
     assert sorted(m.data for _, _, _, m in rows) == [100.0 + k for k in range(10)] + [
         200.0 + k for k in range(10)]
+
+
+def test_status_names_carry_the_namespace(ctx):
+    """Two valves' compensators report apart on /diagnostics (both were 'hyst_id: compensator')."""
+    assert _make(ctx, Compensator, namespace='/rig1').status_name == 'rig1/compensator'
+    assert _make(ctx, Excitation).status_name == 'excitation'

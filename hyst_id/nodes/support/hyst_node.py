@@ -161,6 +161,16 @@ class HystNode(Node):
         if report_unknown:
             self.report_unknown_parameters()
 
+    @property
+    def status_name(self) -> str:
+        """The node's name on ``/diagnostics``: ``rig1/compensator`` in ``/rig1``, else its name.
+
+        Two valves' compensators in two namespaces report apart (both were
+        ``hyst_id: compensator``; found by an independent review).
+        """
+        ns = self.get_namespace().strip('/')
+        return f'{ns}/{self.get_name()}' if ns else self.get_name()
+
     def create_steady_timer(self, period_s: float, callback: Any) -> Any:
         """A timer on the steady (wall) clock, whatever ``use_sim_time`` says."""
         if not hasattr(self, '_steady_clock'):
@@ -242,7 +252,7 @@ class HystNode(Node):
             self._diag_pub = self.create_publisher(DiagnosticArray, DIAGNOSTICS_TOPIC,
                                                    DIAGNOSTICS_QOS)
         try_publish(self._diag_pub, diagnostic_array(
-            self, f'hyst_id: {self.get_name()}: parameters', 2, self._unknown_message,
+            self, f'hyst_id: {self.status_name}: parameters', 2, self._unknown_message,
             {'unknown': ', '.join(self.unknown_parameters)}))
 
     def publish_diagnostics(self, level: int, message: str,
@@ -252,7 +262,7 @@ class HystNode(Node):
         if self._diag_pub is None:
             self._diag_pub = self.create_publisher(DiagnosticArray, DIAGNOSTICS_TOPIC,
                                                    DIAGNOSTICS_QOS)
-        arr = diagnostic_array(self, f'hyst_id: {self.get_name()}', level, message, values)
+        arr = diagnostic_array(self, f'hyst_id: {self.status_name}', level, message, values)
         arr.status.extend(extra)
         try_publish(self._diag_pub, arr)
 
