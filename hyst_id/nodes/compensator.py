@@ -240,6 +240,11 @@ class Compensator(HystNode):
         if not values['min_command'] < values['max_command']:
             return (f'min_command ({values["min_command"]:g}) must be < max_command '
                     f'({values["max_command"]:g})')
+        if 'initial_command' in changed and not (
+                values['min_command'] <= values['initial_command'] <= values['max_command']):
+            return (f'initial_command ({values["initial_command"]:g}) must lie within '
+                    f'[min_command, max_command] = [{values["min_command"]:g}, '
+                    f'{values["max_command"]:g}]: the actuator holds it before the first sample')
         tracking = TrackingLink.validate(values)
         if tracking:
             return tracking

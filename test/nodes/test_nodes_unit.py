@@ -141,6 +141,8 @@ def test_defaults_match_the_params_files():
     (Identifier, {'domains': '/no/such/domains.yaml'}, 'domains'),
     (Identifier, {'pop_size': 1}, 'pop_size'),
     (Identifier, {'hops': -1}, 'hops'),
+    (Identifier, {'min_samples': 5000000}, 'must not exceed max_samples'),
+    (Compensator, {'initial_command': 100.0}, 'initial_command (100) must lie within'),
     (Identifier, {'model': 'preisach'}, 'one of'),
     (Identifier, {'model': 'smooth', 'domains': 'paper'}, 'paper'),
     (Identifier, {'model': 'auto', 'domains': 'paper'}, 'domains must be auto'),

@@ -42,6 +42,9 @@ def validate_identifier_params(values: dict[str, Any], changed: set[str]) -> str
     family), the diagnosis's mechanism ids, the compensator's node name (its
     service name must be valid), and the sliding re-identification's settings.
     """
+    if values['min_samples'] > values['max_samples']:
+        return (f'min_samples ({values["min_samples"]}) must not exceed max_samples '
+                f'({values["max_samples"]}): the buffer could never hold enough to identify')
     dom = values['domains']
     if {'domains', 'model'} & changed and dom != 'auto' and values['model'] == 'auto':
         return "model 'auto' derives each family's domains from the data: domains must be auto"
