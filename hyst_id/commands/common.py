@@ -29,7 +29,7 @@ from hyst_id.io.recording import gap_note, Recording
 
 __all__ = ['add_output_arguments', 'add_recording_arguments', 'add_settings_arguments',
            'load_recording', 'make_spec', 'make_settings', 'parse_columns', 'prepare_outputs',
-           'progress_bar']
+           'progress_bar', 'reading_notes']
 
 
 def add_recording_arguments(parser: argparse.ArgumentParser) -> None:
@@ -131,6 +131,17 @@ def load_recording(args: argparse.Namespace) -> Recording:
         if note:
             print(f'note: {note}', file=sys.stderr)
     return rec
+
+
+def reading_notes(notes) -> list[str]:
+    """A recording's notes that :func:`load_recording` did not print already.
+
+    The time-unit hints are printed as the recording is read; the rest (stamps
+    sorted, messages with a repeated stamp dropped, gaps, the time origin, the
+    columns read) say what reading did to the data.
+    """
+    from hyst_id.io.csv_reader import TIME_UNIT_NOTE
+    return [str(n) for n in notes if not str(n).startswith(TIME_UNIT_NOTE)]
 
 
 def parse_columns(text: str | None) -> tuple[int | str, ...] | None:

@@ -28,6 +28,7 @@ from hyst_id.commands.common import (
     make_spec,
     prepare_outputs,
     progress_bar,
+    reading_notes,
 )
 from hyst_id.errors import ConfigError
 from hyst_id.identification import identify
@@ -65,6 +66,8 @@ def run(args: argparse.Namespace) -> int:
     prepare_outputs(args, plot_is_folder=True)
     print(f'{rec.source}: {rec.n_samples} samples over {rec.duration_s:.1f} s, '
           f'channel {rec.channel}', file=sys.stderr)
+    for note in reading_notes(rec.notes):   # what reading did: stamps sorted, repeats dropped
+        print(f'note: {note}', file=sys.stderr)
     choice = None
     if args.model == 'auto':
         choice = _choose(args, rec, settings)

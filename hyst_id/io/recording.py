@@ -194,7 +194,11 @@ def validate_recording(rec: Recording, *, min_samples: int = MIN_SAMPLES,
             f'length mismatch: {n} times, {arrays["command"].shape[0]} commands, '
             f'{arrays["measurement"].shape[0]} measurements')
     if n < min_samples:
-        raise RecordingError(f'too few samples: {n} (need at least {min_samples})')
+        dropped = [str(note) for note in rec.notes if 'duplicate stamp' in str(note)]
+        why = (f' after reading: {"; ".join(dropped)} (the stamps repeat: all zero, or the '
+               'streams stamped by different clocks? give header.stamp or record with source '
+               'time)' if dropped else '')
+        raise RecordingError(f'too few samples: {n} (need at least {min_samples}){why}')
     for name, arr in arrays.items():
         bad = ~np.isfinite(arr)
         if bad.any():

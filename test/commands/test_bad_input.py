@@ -76,6 +76,20 @@ def wrong_type_bag(tmp: Path) -> Path:
     return path
 
 
+def zero_stamp_bag(tmp: Path) -> Path:
+    """Every message stamped 0 (header and log time): reading keeps one sample."""
+    path = tmp / 'zero_stamps'
+    cfg = TopicConfig.for_channel('position')
+    with BagWriter(path) as writer:
+        writer.add_topic(cfg.command_topic, 'std_msgs/msg/Float64')
+        writer.add_topic(cfg.measurement_topic, cfg.measurement_type)
+        for i in range(T.size):
+            writer.write(cfg.command_topic, 0, {'data': float(V[i])})
+            writer.write(cfg.measurement_topic, 0, {'header': {'stamp': 0},
+                                                    'position': [float(Y[i])]})
+    return path
+
+
 def no_topics_bag(tmp: Path) -> Path:
     path = tmp / 'other_topics'
     with BagWriter(path) as writer:
@@ -145,6 +159,7 @@ CASES = [
      'reverses'),
     ('too-few-samples', lambda d: [str(write_csv(d / 'few.csv', t=T[:5], v=V[:5], y=Y[:5]))],
      'too few'),
+    ('zero-stamps-mcap', lambda d: [str(zero_stamp_bag(d))], 'the stamps repeat'),
     ('random-bytes-mcap', lambda d: [str(_bytes(d / 'junk.mcap', np.random.default_rng(0)
                                                 .bytes(4096)))], 'bag'),
     ('zero-byte-mcap', lambda d: [str(_bytes(d / 'zero.mcap', b''))], 'bag'),
@@ -241,6 +256,8 @@ def test_a_killed_recorders_bag_is_read_with_a_note(tmp_path, capsys):
                  '--workers', '1', '--hops', '0', '--global-runs', '0']) == 0
     out = capsys.readouterr()
     assert 'has no MCAP footer' in out.err and 'complete chunks' in out.err
+    # what reading did is said (identify printed none of the reader's notes before)
+    assert 'is truncated (no footer): recovered' in out.err
     said = re.search(r'(\d+) samples over', out.out + out.err)
     assert said and 0 < int(said.group(1)) < T.size, out
 
