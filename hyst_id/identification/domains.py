@@ -93,6 +93,7 @@ from hyst_id.identification.loop import (
     measurement_sign,
     steepest_slope,
 )
+from hyst_id.io.numbers import level
 from hyst_id.io.recording import Recording
 from hyst_id.models.family import HysteresisFamily, LoopBox
 from hyst_id.models.registry import get_family
@@ -299,4 +300,5 @@ def preset_spec(name: str, channel: str,
 
 def format_domains(spec: ChainSpec) -> str:
     """One line listing each parameter's domain, for logs and reports."""
-    return ', '.join(f'{n} [{lo:.4g}, {hi:.4g}]' for n, (lo, hi) in zip(spec.names, spec.bounds))
+    return ', '.join(f'{n} [{level(lo, hi - lo)}, {level(hi, hi - lo)}]'
+                     for n, (lo, hi) in zip(spec.names, spec.bounds))

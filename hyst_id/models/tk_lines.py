@@ -23,6 +23,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from hyst_id.io.numbers import level
+
 __all__ = ['BARELY', 'LINE_PARAMS', 'active_lines', 'unexcited_lines']
 
 #: A line followed over less than this fraction of the command span is barely excited.
@@ -149,10 +151,11 @@ def unexcited_lines(params: np.ndarray, command: np.ndarray, u: np.ndarray,
                 'recording')
         short = (extreme < v_corner) if verb == 'rises' else (extreme > v_corner)
         if short:
+            vspan = float(np.ptp(v))
             out.append(f'the {line} line of the loop is never reached: the command {verb} '
-                       f'to {extreme:.4g}{unit} but the {corner} of the loop is at '
-                       f'{v_corner:.4g}{unit}; {what} (drive the command {side} '
-                       f'{v_corner:.4g}{unit} to identify it)')
+                       f'to {level(extreme, vspan)}{unit} but the {corner} of the loop is at '
+                       f'{level(v_corner, vspan)}{unit}; {what} (drive the command {side} '
+                       f'{level(v_corner, vspan)}{unit} to identify it)')
         else:
             out.append(f'the {line} line of the loop barely matters here (it sets the output '
                        f'over less than {100 * BARELY:.0f} % of the command span and moves it '
