@@ -52,7 +52,8 @@ from hyst_id.rig.physics import FLOW_MODELS, STANDARD_ATMOSPHERE_PA
 __all__ = [
     'GasParams', 'SupplyParams', 'PipeParams', 'ManualValveParams', 'ControlValveParams',
     'ActuatorParams', 'PositionSensorParams', 'PressureSensorParams', 'FlowSensorParams',
-    'IntegrationParams', 'RigParams', 'rig_params_from_dict', 'rig_params_to_dict',
+    'IntegrationParams', 'RIG_GROUPS', 'RigParams', 'rig_params_from_dict',
+    'rig_params_to_dict',
 ]
 
 
@@ -339,6 +340,8 @@ class RigParams:
 
 
 _GROUPS = {f.name: f.default_factory for f in fields(RigParams)}
+#: The rig's parameter groups, in declaration order.
+RIG_GROUPS = tuple(_GROUPS)
 _GROUP_OF = {cls: name for name, cls in _GROUPS.items()}
 
 

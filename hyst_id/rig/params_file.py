@@ -23,6 +23,7 @@ path or nothing).
 
 from __future__ import annotations
 
+import difflib
 from pathlib import Path
 from typing import Any, Mapping
 
@@ -33,6 +34,7 @@ from hyst_id.io.params_file import read_yaml
 from hyst_id.rig.params import (
     _merge,
     _unflatten,
+    RIG_GROUPS,
     rig_params_from_dict,
     rig_params_to_dict,
     RigParams,
@@ -42,6 +44,9 @@ __all__ = ['DEFAULT_NODE', 'as_rig_params', 'load_rig_params', 'save_rig_params'
 
 #: Node section written by :func:`save_rig_params`.
 DEFAULT_NODE = 'pipeline_sim'
+
+#: Groups of node parameters a ROS params file may hold beside the rig's.
+NODE_GROUPS = ('topics', 'qos_overrides')
 
 
 def load_rig_params(yaml_path: str | Path, *, node: str | None = None) -> RigParams:
@@ -84,6 +89,15 @@ def _from_document(doc: Any, node: str | None = None) -> RigParams:
         if not isinstance(section, Mapping):
             raise ConfigError('ros__parameters must be a mapping')
         _merge(merged, _unflatten(section))
+    # a node's own parameters may share the section, but a group that is neither a rig
+    # group nor a node's is a typo (``suply``) or another node's file: it was ignored
+    strays = sorted(k for k, v in merged.items() if isinstance(v, Mapping)
+                    and k not in RIG_GROUPS and k not in NODE_GROUPS)
+    if strays:
+        hints = [f'{k} (did you mean {close[0]}?)' if close else k for k, close in
+                 ((k, difflib.get_close_matches(k, RIG_GROUPS, 1)) for k in strays)]
+        raise ConfigError(f'unknown parameter group(s) {", ".join(hints)}; rig groups: '
+                          f'{", ".join(RIG_GROUPS)}')
     return rig_params_from_dict(merged, allow_unknown=True)
 
 

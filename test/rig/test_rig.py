@@ -476,3 +476,22 @@ def test_identification_on_default_rig_reaches_its_floor():
     settings = IdentifySettings(seeds=(0, 1, 2, 3), long_runs_within=1.5, hops=0)
     pres = identify(run.recording('pressure'), settings=settings)
     assert pres.er_percent < 1.0
+
+
+def test_a_misspelled_group_in_a_ros_params_file_is_refused(tmp_path):
+    """``suply:`` in a node's params file was ignored (the supply stayed regulated).
+
+    Node parameters may share the section; a group that is neither the rig's nor a
+    node's is a typo or another node's file (found by an independent review).
+    """
+    typo = tmp_path / 'typo.yaml'
+    typo.write_text('/**:\n  ros__parameters:\n    suply: {regulation: false}\n    plant: rig\n'
+                    '    topics: {command_topic: hyst_id/command}\n')
+    with pytest.raises(ConfigError, match=r'suply \(did you mean supply\?\)'):
+        load_rig_params(typo)
+    other = Path(__file__).resolve().parents[2] / 'params' / 'compensator.yaml'
+    with pytest.raises(ConfigError, match='augment'):
+        load_rig_params(other)
+    good = tmp_path / 'good.yaml'
+    good.write_text('/**:\n  ros__parameters:\n    supply: {regulation: false}\n    plant: rig\n')
+    assert load_rig_params(good).supply.regulation is False
