@@ -84,7 +84,7 @@ from hyst_id.errors import ConfigError
 from hyst_id.identification.chains import chain_spec, ChainSpec
 from hyst_id.io.recording import Recording, roundoff_probe, validate_part, validate_recording
 from hyst_id.signals.noise import floor_percent
-from hyst_id.signals.reversals import period_s
+from hyst_id.signals.reversals import command_context
 from hyst_id.signals.split import inside_rows, split_index
 
 __all__ = ['UNKNOWN_FACTOR', 'WHOLE_RECORD_FACTOR', 'diagnose', 'finding_from', 'gain_call',
@@ -220,7 +220,7 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
     ctx = Context(channel=rec.channel, t_s=t, n_train=n_train, command_scale=scale,
                   command_unit=rec.command_unit, measurement_unit=rec.measurement_unit,
                   measurement_name=rec.measurement_name,
-                  extra={'period_s': period_s(t[:n_train], v[:n_train])})
+                  extra=command_context(t[:n_train], v[:n_train]))
     sigma = noise_std(y) or 1e-12 * float(np.max(np.abs(y)))    # noise-free: no 0 floor
     data = Data(t_s=t, v=v, y=y, n_train=n_train, noise_std=sigma,
                 judged=inside_rows(v, n_train))

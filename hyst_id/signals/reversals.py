@@ -28,6 +28,7 @@ import numpy as np
 
 __all__ = [
     'DEFAULT_TOLERANCE',
+    'command_context',
     'count_reversals',
     'half_period_s',
     'period_s',
@@ -129,3 +130,21 @@ def period_s(t_s: np.ndarray, command: np.ndarray) -> float:
         return float(2.0 * np.median(np.diff(rev)))
     t = np.asarray(t_s, dtype=np.float64)
     return float(0.25 * (t[-1] - t[0]))
+
+
+def command_context(t_s: np.ndarray, command: np.ndarray) -> dict[str, float]:
+    """What the diagnosis's blocks need to know of a command: its loop period, span and speed.
+
+    Returns
+    -------
+    dict
+        ``period_s`` (:func:`period_s`), ``command_span`` (max - min, the
+        command's units) and ``command_rate_max`` (the largest change between
+        two samples over their interval, units per second).
+    """
+    t = np.asarray(t_s, dtype=np.float64)
+    v = np.asarray(command, dtype=np.float64)
+    dt = np.diff(t)
+    rates = np.abs(np.diff(v)) / np.where(dt > 0.0, dt, np.inf)
+    return {'period_s': period_s(t, v), 'command_span': float(np.ptp(v)) if v.size else 0.0,
+            'command_rate_max': float(np.max(rates)) if rates.size else 0.0}

@@ -115,7 +115,7 @@ def test_dead_time_is_named_with_its_value(delay_diagnosis):
 @pytest.mark.parametrize('mech', [m for m in MECHANISM_IDS    # own test modules
                                   if m not in ('dead_time', 'loop_shape', 'creep',
                                                'actuator_dynamics', 'friction', 'gain_loss',
-                                               'bouc_wen')])
+                                               'bouc_wen', 'rate_limit')])
 def test_each_mechanism_is_named(mech):
     d = diagnose(synthetic(mech, seed=5), settings=FAST)
     assert d.verdict == mech, d.report()

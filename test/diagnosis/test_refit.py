@@ -42,7 +42,7 @@ TRUTH = np.array([1.01, 1.05, 0.10, 0.15, -0.25, 0.50, 14.0, 7.0, 1.0, -0.15, 0.
 #: Blocks inverted on data (the others' ``undo`` is None by design: filters, end stops,
 #: a replaced actuator or a map of the position are not inverted on noisy samples).
 INVERTIBLE = {'dead_time', 'offset_drift', 'gain_drift', 'gain_loss', 'supply_decay', 'creep',
-              'friction', 'bouc_wen'}
+              'friction', 'bouc_wen', 'rate_limit'}
 
 
 def _record(t):

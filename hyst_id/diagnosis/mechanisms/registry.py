@@ -32,6 +32,7 @@ from hyst_id.diagnosis.mechanisms import (
     loop_shape,
     offset_drift,
     rate_dependence,
+    rate_limit,
     saturation,
     sensor_lag,
     static_nonlinearity,
@@ -48,7 +49,7 @@ __all__ = ['MECHANISMS', 'MECHANISM_IDS', 'Context', 'Mechanism', 'Quantity', 'g
 MECHANISMS: dict[str, Mechanism] = {m.MECHANISM.id: m.MECHANISM for m in (
     dead_time, sensor_lag, supply_decay, offset_drift, saturation, stiction,
     static_nonlinearity, rate_dependence, loop_shape, gain_drift, gain_loss, creep,
-    actuator_dynamics, friction, bouc_wen)}
+    actuator_dynamics, friction, bouc_wen, rate_limit)}
 
 #: The ids alone.
 MECHANISM_IDS = tuple(MECHANISMS)
