@@ -96,6 +96,15 @@ def _logu(rng: np.random.Generator, lo: float, hi: float) -> float:
     return float(np.exp(rng.uniform(np.log(lo), np.log(hi))))
 
 
+def draw_excitation(rng: np.random.Generator, t: np.ndarray) -> tuple[str, np.ndarray]:
+    """The family's excitation: one of ``EXCITATIONS`` or moves and holds, and its command."""
+    kind = (*EXCITATIONS, 'moves and holds')[int(rng.integers(0, len(EXCITATIONS) + 1))]
+    if kind == 'moves and holds':
+        return kind, moves_and_holds(rng, t, dwell_s=t[-1] / 25, move_s=t[-1] / 200,
+                                     n_levels=25, lo=6.5, hi=11.5)
+    return kind, _excitation(kind, t, rng)
+
+
 def draw(index: int, only: frozenset | None = None) -> dict:
     """Recording ``index``: command, measurement, the effects and their magnitudes.
 
@@ -112,12 +121,7 @@ def draw(index: int, only: frozenset | None = None) -> dict:
     on = {e for e in effects if only is None or e in only}
     dt = float(rng.choice([0.01, 0.02, 0.05, 0.1]))
     t = np.arange(N_SAMPLES) * dt
-    kind = (*EXCITATIONS, 'moves and holds')[int(rng.integers(0, len(EXCITATIONS) + 1))]
-    if kind == 'moves and holds':
-        v = moves_and_holds(rng, t, dwell_s=t[-1] / 25, move_s=t[-1] / 200, n_levels=25,
-                            lo=6.5, hi=11.5)
-    else:
-        v = _excitation(kind, t, rng)
+    kind, v = draw_excitation(rng, t)
     p = _draw_params(channel, v, rng, t[-1])
     mags: dict[str, float] = {}
     vv = v

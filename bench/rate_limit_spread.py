@@ -43,8 +43,8 @@ sys.path.insert(0, str(ROOT / 'test'))
 sys.path.insert(0, str(ROOT / 'test' / 'diagnosis'))
 sys.path.insert(0, str(ROOT))
 
-from excitations import moves_and_holds  # noqa: E402, I100
-from generalisation import _draw_params, _excitation, EXCITATIONS  # noqa: E402, I100
+from blind_family import draw_excitation  # noqa: E402, I100
+from generalisation import _draw_params  # noqa: E402, I100
 from reference_sim import first_order_sensor  # noqa: E402, I100
 from reference_sim import simulate as reference_simulate  # noqa: E402, I100
 from test_rate_limit import _recording, RATE_MA_S, reference_slew, SETTINGS  # noqa: E402
@@ -59,12 +59,7 @@ def drawn(index: int) -> tuple[Recording, float]:
     channel = ('position', 'pressure')[index % 2]
     dt = float(rng.choice([0.02, 0.05, 0.1]))
     t = np.arange(2000) * dt
-    kind = (*EXCITATIONS, 'moves and holds')[int(rng.integers(0, len(EXCITATIONS) + 1))]
-    if kind == 'moves and holds':
-        v = moves_and_holds(rng, t, dwell_s=t[-1] / 25, move_s=t[-1] / 200, n_levels=25,
-                            lo=6.5, hi=11.5)
-    else:
-        v = _excitation(kind, t, rng)
+    kind, v = draw_excitation(rng, t)
     p = _draw_params(channel, v, rng, t[-1])
     rate = float(np.ptp(v)) / float(np.exp(rng.uniform(np.log(2.0), np.log(20.0))))
     x = reference_simulate('position', p, t, reference_slew(t, v, rate))
