@@ -179,9 +179,10 @@ def implausible_after(comp, data, ctx) -> str:
     """
     fit = comp.fit
     mech = MECHANISMS.get(comp.mechanism)
-    if mech is None or fit.model is None or mech.id not in fit.model.slices:
+    model = getattr(fit, 'model', None)     # a fit without its model cannot be judged
+    if mech is None or model is None or mech.id not in model.slices:
         return ''
-    return mech.implausible(fit.model.theta(fit.p, mech.id), fit.coef, fit.span,
+    return mech.implausible(model.theta(fit.p, mech.id), fit.coef, fit.span,
                             data.noise_std, ctx, fit.labels)
 
 
