@@ -47,6 +47,7 @@ plus any messages still in transit to it.
 from __future__ import annotations
 
 from collections import deque
+from dataclasses import dataclass, field
 import datetime
 from pathlib import Path
 import threading
@@ -122,6 +123,33 @@ def _offered(qos: QoSProfile) -> dict[str, Any]:
             'avoid_ros_namespace_conventions': bool(qos.avoid_ros_namespace_conventions)}
 
 
+@dataclass
+class _Stream:
+    """One recorded (topic, type): its subscription, and what drops repeats after a swap."""
+
+    writer_key: str                 # the bag connection's key (the topic, for its first type)
+    sub: Any = None
+    qos: QoSProfile | None = None
+    repeats_until_ns: int = 0       # a resubscription's overlap: repeats dropped until then
+    recent: deque = field(default_factory=lambda: deque(maxlen=256))
+
+    def repeat(self, source_stamp: int | None, data: bytes) -> bool:
+        """Whether a message was delivered already (only within a resubscription's overlap).
+
+        The last messages are remembered always, so that a latched topic's history
+        delivered again by the new subscription is recognised.
+        """
+        if not source_stamp:
+            return False
+        seen = (source_stamp, hash(data))
+        if self.repeats_until_ns and time.monotonic_ns() > self.repeats_until_ns:
+            self.repeats_until_ns = 0
+        if self.repeats_until_ns and seen in self.recent:
+            return True
+        self.recent.append(seen)
+        return False
+
+
 class Recorder(HystNode):
     """Write the configured topics into an MCAP bag until shut down."""
 
@@ -136,8 +164,7 @@ class Recorder(HystNode):
         self._lock = threading.Lock()
         self._writer = BagWriter(self.path, chunk_size=self.p('chunk_size'),
                                  chunk_span_s=self.p('chunk_span_s')).open()
-        #: (topic, type) -> [subscription, its QoS, dedupe window end (ns), recent keys]
-        self._subs: dict[tuple[str, str], list] = {}
+        self._subs: dict[tuple[str, str], _Stream] = {}
         self._unrecordable: dict[tuple[str, str], str] = {}
         self.counts: dict[str, int] = {}
         self.create_steady_timer(self.p('discovery_period_s'), self._discover)
@@ -186,74 +213,63 @@ class Recorder(HystNode):
                     self._subscribe(topic, msgtype, mine)
 
     def _subscribe(self, topic: str, msgtype: str, infos: list) -> None:
-        first = not any(t == topic for t, _ in self._subs)
+        first = next((m for t, m in self._subs if t == topic), None)
+        stream = _Stream(topic if first is None else f'{topic}\0{msgtype}')
         try:
             cls = message_class(msgtype)
             with self._lock:
                 self._writer.add_topic(topic, msgtype, [_offered(i.qos_profile) for i in infos],
-                                       key=None if first else f'{topic}\0{msgtype}')
+                                       key=stream.writer_key)
         except (ConfigError, ValueError) as exc:
             self._unrecordable[(topic, msgtype)] = str(exc)
             self.get_logger().error(f'cannot record {topic} ({msgtype}): {exc}')
             return
-        self._subs[(topic, msgtype)] = [None, None, 0, deque(maxlen=256)]
         try:
-            self._make_subscription(topic, msgtype, cls, _qos_for(infos))
+            self._make_subscription(topic, stream, cls, _qos_for(infos))
         except RuntimeError as exc:     # Fast DDS: one type per topic in a process
-            del self._subs[(topic, msgtype)]
-            why = ('this middleware takes one type per topic in a process; recording '
-                   f'{self._first_type(topic)}' if not first else first_line(exc))
+            why = (f'this middleware takes one type per topic in a process; recording {first}'
+                   if first is not None else first_line(exc))
             self._unrecordable[(topic, msgtype)] = why
             self.get_logger().error(f'{topic} carries several types: its {msgtype} messages '
                                     f'are NOT recorded ({why})')
             return
+        self._subs[(topic, msgtype)] = stream
         self.counts.setdefault(topic, 0)
         self.get_logger().info(f'recording {topic} ({msgtype}, '
-                               f'{self._subs[(topic, msgtype)][1].reliability.name.lower()})')
+                               f'{stream.qos.reliability.name.lower()})')
 
-    def _make_subscription(self, topic: str, msgtype: str, cls: Any, qos: QoSProfile) -> None:
+    def _make_subscription(self, topic: str, stream: _Stream, cls: Any,
+                           qos: QoSProfile) -> None:
         """(Re)subscribe; the old subscription goes after the new one is up (no gap)."""
-        entry = self._subs[(topic, msgtype)]
-        old = entry[0]
-        key = None if self._first_type(topic) == msgtype else f'{topic}\0{msgtype}'
-        entry[0] = self.create_subscription(
-            cls, topic, lambda data, info, k=(topic, msgtype), w=key or topic:
-            self._on_message(k, w, data, info), qos, raw=True)
-        entry[1] = qos
+        old = stream.sub
+        stream.sub = self.create_subscription(
+            cls, topic, lambda data, info: self._on_message(topic, stream, data, info), qos,
+            raw=True)
+        stream.qos = qos
         if old is not None:     # both deliver for a moment: drop repeats for 2 s
-            entry[2] = time.monotonic_ns() + 2 * 10**9
+            stream.repeats_until_ns = time.monotonic_ns() + 2 * 10**9
             self.destroy_subscription(old)
-
-    def _first_type(self, topic: str) -> str:
-        return next(m for t, m in self._subs if t == topic)
 
     def _follow_qos(self, topic: str, msgtype: str, infos: list) -> None:
         want = _qos_for(infos)
-        have = self._subs[(topic, msgtype)][1]
+        have = self._subs[(topic, msgtype)].qos
         if (want.reliability, want.durability) == (have.reliability, have.durability):
             return
         self.get_logger().warning(
             f'{topic}: its publishers now offer {want.reliability.name.lower()}, '
             f'{want.durability.name.lower()}; subscribing again so that every one is recorded')
-        self._make_subscription(topic, msgtype, message_class(msgtype), want)
+        self._make_subscription(topic, self._subs[(topic, msgtype)], message_class(msgtype),
+                                want)
 
-    def _on_message(self, key: tuple[str, str], writer_key: str, data: bytes,
-                    info: dict) -> None:
+    def _on_message(self, topic: str, stream: _Stream, data: bytes, info: dict) -> None:
+        if stream.repeat(info.get('source_timestamp'), data):
+            return
         t_ns = source_time_ns(self, info)
-        entry = self._subs[key]
-        stamp = info.get('source_timestamp')
-        if stamp:                    # the last messages, to drop repeats after a resubscription
-            seen = (stamp, hash(bytes(data)))
-            if entry[2] and seen in entry[3]:
-                if time.monotonic_ns() <= entry[2]:
-                    return
-                entry[2] = 0
-            entry[3].append(seen)
         with self._lock:
             if self._writer is None:
                 return
-            self._writer.write(writer_key, t_ns, data)
-            self.counts[key[0]] += 1
+            self._writer.write(stream.writer_key, t_ns, data)
+            self.counts[topic] += 1
 
     def _flush(self) -> None:
         with self._lock:
