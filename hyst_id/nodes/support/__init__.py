@@ -44,6 +44,7 @@ from hyst_id.nodes.support.ros import (
                                        init_ros,
                                        input_problems,
                                        message_class,
+                                       publisher_mismatches,
                                        resolved,
                                        source_time_ns,
                                        spin_in_background,
@@ -52,7 +53,6 @@ from hyst_id.nodes.support.ros import (
                                        stamp_ns,
                                        stop_signals,
                                        try_publish,
-                                       type_mismatches,
 )
 from hyst_id.nodes.support.scalar import CommandClock, ScalarStream
 
@@ -65,5 +65,5 @@ __all__ = [
     'message_class', 'Param', 'ParameterPusher', 'resolved', 'ScalarStream',
     'scalar_type_param', 'source_time_ns',
     'spin_in_background', 'spin_node', 'spin_until_stopped', 'stamp_ns', 'stop_signals',
-    'topic_params', 'try_publish', 'type_mismatches',
+    'topic_params', 'try_publish', 'publisher_mismatches',
 ]

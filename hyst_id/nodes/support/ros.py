@@ -44,7 +44,7 @@ __all__ = ['EXIT_SIGINT', 'check_field', 'diagnostic_array', 'exit_code_after', 
            'init_ros',
            'input_problems', 'message_class', 'qos_mismatch', 'resolved', 'source_time_ns',
            'spin_in_background', 'spin_node', 'spin_until_stopped', 'stamp_ns', 'stop_signals',
-           'try_publish', 'type_mismatches']
+           'try_publish', 'publisher_mismatches']
 
 _RCLError = _rclpy.RCLError
 
@@ -229,7 +229,7 @@ def diagnostic_array(node: Node, name: str, level: int | bytes, message: str,
     return arr
 
 
-def type_mismatches(node: Node, topic: str, expected: str) -> list[str]:
+def publisher_mismatches(node: Node, topic: str, expected: str) -> list[str]:
     """Publishers on ``topic`` this node never hears from, in words: wrong type or QoS.
 
     ``topic`` may be relative (the node's namespace and remaps apply);
@@ -282,7 +282,7 @@ def input_problems(node: Node, expected: Sequence[tuple[str, str]], rx: Mapping[
     """
     out = []
     for topic, want in expected:
-        for m in type_mismatches(node, topic, want):
+        for m in publisher_mismatches(node, topic, want):
             out.append(f'{resolved(node, topic)}: {m}, expected {want} (never received)')
     now = time.monotonic()
     if now - started > timeout_s:
