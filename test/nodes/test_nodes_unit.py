@@ -639,3 +639,30 @@ def test_status_names_carry_the_namespace(ctx):
     """Two valves' compensators report apart on /diagnostics (both were 'hyst_id: compensator')."""
     assert _make(ctx, Compensator, namespace='/rig1').status_name == 'rig1/compensator'
     assert _make(ctx, Excitation).status_name == 'excitation'
+
+
+def test_a_resubscription_does_not_record_a_latched_message_twice(ctx, tmp_path):
+    """The new subscription gets a latched topic's history again; it is written once.
+
+    A volatile publisher joining a latched one makes the recorder subscribe volatile;
+    when it leaves, the recorder subscribes latched again, and the latched message,
+    recorded already, arrives again on the new subscription: dropped as a repeat.
+    """
+    rec = _make(ctx, Recorder, parameter_overrides=[
+        Parameter('output', value=str(tmp_path / 'bag')),
+        Parameter('topics', value=['/params'])])
+    talker = _make(ctx, Node, 'talker')
+    talker.create_publisher(String, '/params', LATCHED_QOS).publish(String(data='first'))
+    assert _spin_until(ctx, [rec, talker], lambda: rec.counts.get('/params') == 1)
+    volatile = talker.create_publisher(String, '/params', 10)
+    assert _spin_until(ctx, [rec, talker], lambda: volatile.get_subscription_count() > 0,
+                       timeout=15.0)
+    talker.destroy_publisher(volatile)
+    stream = rec._subs[('/params', 'std_msgs/msg/String')]
+    assert _spin_until(ctx, [rec, talker], lambda: stream.qos.durability
+                       == LATCHED_QOS.durability, timeout=15.0)
+    _spin_until(ctx, [rec, talker], lambda: False, timeout=1.0)    # the history arrives
+    assert rec.counts['/params'] == 1
+    rec.close()
+    rows = list(iter_bag_messages(tmp_path / 'bag', topics=['/params']))
+    assert [m.data for _, _, _, m in rows] == ['first']
