@@ -26,11 +26,15 @@ over the noise floor.
 Run from the repository root (about 10 minutes on 2 cores)::
 
     python bench/rate_limit_spread.py [--seeds 6] [--drawn 6]
+    python bench/rate_limit_spread.py --seeds 2 --drawn 0 --without   # the library before it
+    python bench/rate_limit_spread.py --seeds 4 --drawn 0 --probes 1 2  # other CPU makes
 """
 
 from __future__ import annotations
 
 import argparse
+from dataclasses import replace
+import os
 from pathlib import Path
 import sys
 import time
@@ -50,7 +54,8 @@ from reference_sim import simulate as reference_simulate  # noqa: E402, I100
 from test_rate_limit import _recording, RATE_MA_S, reference_slew, SETTINGS  # noqa: E402
 
 from hyst_id.diagnosis import diagnose, DiagnoseSettings  # noqa: E402, I100
-from hyst_id.io.recording import Recording  # noqa: E402
+from hyst_id.diagnosis.mechanisms import get_mechanisms  # noqa: E402
+from hyst_id.io.recording import Recording, ROUNDOFF_PROBE_ENV  # noqa: E402
 
 
 def drawn(index: int) -> tuple[Recording, float]:
@@ -87,17 +92,34 @@ def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument('--seeds', type=int, default=6)
     ap.add_argument('--drawn', type=int, default=6)
+    ap.add_argument('--probes', type=int, nargs='*', default=[], metavar='SEED',
+                    help='part 1 under these round-off probes instead (another CPU make)')
+    ap.add_argument('--without', action='store_true',
+                    help='offer every block but rate_limit: what the library said before it')
     args = ap.parse_args()
-    for seed in range(args.seeds):
-        for rate in (RATE_MA_S, None):
-            t0 = time.perf_counter()
-            d = diagnose(_recording(seed, rate), settings=SETTINGS)
-            label = f'test seed {seed}, ' + ('limited' if rate else 'no limit')
-            print(_line(label, d, rate, time.perf_counter() - t0), flush=True)
+
+    def offered(settings: DiagnoseSettings, channel: str) -> DiagnoseSettings:
+        if not args.without:
+            return settings
+        return replace(settings, mechanisms=tuple(
+            m.id for m in get_mechanisms(channel=channel) if m.id != 'rate_limit'))
+
+    tests = offered(SETTINGS, 'position')
+    for probe in args.probes or [None]:
+        if probe is not None:
+            os.environ[ROUNDOFF_PROBE_ENV] = str(probe)
+        for seed in range(args.seeds):
+            for rate in (RATE_MA_S, None):
+                t0 = time.perf_counter()
+                d = diagnose(_recording(seed, rate), settings=tests)
+                label = (f'test seed {seed}, ' + ('limited' if rate else 'no limit')
+                         + (f', probe {probe}' if probe is not None else ''))
+                print(_line(label, d, rate, time.perf_counter() - t0), flush=True)
+    os.environ.pop(ROUNDOFF_PROBE_ENV, None)
     for index in range(args.drawn):
         rec, rate = drawn(index)
         t0 = time.perf_counter()
-        d = diagnose(rec, settings=DiagnoseSettings())
+        d = diagnose(rec, settings=offered(DiagnoseSettings(), rec.channel))
         print(_line(f'drawn {index} {rec.channel} {rec.source}', d, rate,
                     time.perf_counter() - t0), flush=True)
     return 0

@@ -29,8 +29,9 @@ It differs from :mod:`.dead_time` (a shift of every move by the same time),
 size of the move) and :mod:`.actuator_dynamics` (overshoot and ringing): a
 limited rate makes a large step take longer than a small one, with straight
 ramps. Before the block a slew-limited actuator (from a simulator written
-apart, ``test/diagnosis/test_rate_limit.py``) was named ``actuator_dynamics``
-or ``creep`` with 28-31 x the noise floor left.
+apart, ``test/diagnosis/test_rate_limit.py``) was named ``actuator_dynamics``,
+``rate_dependence`` or ``supply_decay`` with 7-35 x the noise floor left
+(``bench/rate_limit_spread.py --without``).
 
 Signature in the residual: correlated with the command rate, only where the
 command moves faster than ``R``.
