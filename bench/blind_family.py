@@ -215,7 +215,7 @@ def run(index: int, workers: int = 1, more_starts: bool = False) -> dict:
                calls=[[a['mechanism'] for a in f.alternatives
                        if a.get('kind', 'tied') in ('tied', 'close', 'signature', 'hold', 'split')]
                       for f in held],
-               # the final residual's time x level t (driver.gain_call's signature)
+               # the final residual's time x level t (exchange.gain_call's signature)
                level_t=d.final_localization.trend['level_t'],
                # blocked cross-validation: time blocks better / worse, per finding
                blocked=[[f.blocked_cv['better'], f.blocked_cv['worse']] for f in held],
@@ -514,9 +514,10 @@ def main() -> int:
     ap.add_argument('--from-json', action='store_true',
                     help='only reprint the tables from docs/diagnosis_blind.json (with '
                     '--diagnose-workers K: of a run one at a time in K processes)')
-    ap.add_argument('--merge', metavar='ROWS_JSON',
+    ap.add_argument('--merge', metavar='ROWS_JSON', nargs='+',
                     help='with --from-json: the rows of ROWS_JSON (a rerun of some '
-                         'recordings, --rows-out) in place of the documented ones')
+                         'recordings, --rows-out) in place of the documented ones; of '
+                         'several files, a later one wins')
     ap.add_argument('--write-md', action='store_true',
                     help='with --from-json: write them to docs/diagnosis_blind.md too (after '
                     'bench/blind_effect_costs.py added its figures)')
@@ -535,7 +536,7 @@ def main() -> int:
                     help='start no new recording after M minutes (a full run resumes from '
                          'docs/diagnosis_blind.partial.jsonl next time)')
     args = ap.parse_args()
-    for given in (args.compare, args.against, args.merge):
+    for given in (args.compare, args.against, *(args.merge or [])):
         if given and not Path(given).is_file():
             print(f'blind_family: no such rows file: {given}', file=sys.stderr)
             return 2
@@ -558,9 +559,13 @@ def main() -> int:
         k = args.diagnose_workers
         rows = json.loads((ROOT / 'docs' / 'diagnosis_blind.json').read_text())
         if args.merge:
-            again = {r['index']: r for r in json.loads(Path(args.merge).read_text())}
+            again = {}
+            for name in args.merge:
+                more = {r['index']: r for r in json.loads(Path(name).read_text())}
+                print(f'{len(more)} rows from {name}')
+                again.update(more)
             rows = [again.get(r['index'], r) for r in rows]
-            print(f'the documented rows with {len(again)} from {args.merge} in their place')
+            print(f'the documented rows with {len(again)} of those in their place')
         text = summary(rows, 'one worker each' if k <= 1 else f'one at a time in {k} processes')
         print(text)
         if args.write_md and args.merge:

@@ -61,8 +61,9 @@ from hyst_id.diagnosis.challenge import chain_fit, challenge, withdrawn_note
 from hyst_id.diagnosis.control import drop_superseded, equivalent_chain, null_control
 from hyst_id.diagnosis.control import recheck
 from hyst_id.diagnosis.empirical import empirical_block
-from hyst_id.diagnosis.exchange import exchanged_call, exchanges
-from hyst_id.diagnosis.locate import LEVEL_TREND_T, Localization, locate, noise_std
+from hyst_id.diagnosis.exchange import drift_exchange, Exchange, exchanged_call, exchanges
+from hyst_id.diagnosis.exchange import gain_call
+from hyst_id.diagnosis.locate import Localization, locate, noise_std
 from hyst_id.diagnosis.mechanisms import get_mechanisms
 from hyst_id.diagnosis.mechanisms.base import Context, Mechanism
 from hyst_id.diagnosis.refit import contest
@@ -87,8 +88,7 @@ from hyst_id.signals.noise import floor_percent
 from hyst_id.signals.reversals import command_context
 from hyst_id.signals.split import inside_rows, split_index
 
-__all__ = ['UNKNOWN_FACTOR', 'WHOLE_RECORD_FACTOR', 'diagnose', 'finding_from', 'gain_call',
-           'located_where']
+__all__ = ['UNKNOWN_FACTOR', 'WHOLE_RECORD_FACTOR', 'diagnose', 'finding_from', 'located_where']
 
 #: Held-out %e_r over the noise floor above which what is left counts as missing physics.
 UNKNOWN_FACTOR = 1.5
@@ -324,15 +324,16 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
         if dropped:
             findings = [f for f in findings if f.mechanism not in dropped]
             loc = relocate(current)
-    for x in exchanges(current, [f.mechanism for f in findings], round_comps, mechs, data, ctx,
-                       settings, chain_starts, relocate, say):
-        mech = next(m for m in mechs if m.id == x.comparison.mechanism)
-        old, findings[x.index] = findings[x.index], finding_from(
-            x.comparison, x.before, mech, relocate(x.before), ctx, v_orig)
-        findings[x.index].alternatives = [exchanged_call(x, data)] + [
-            a for a in old.alternatives if a['mechanism'] != mech.id]
-        findings[x.index].blocked_cv = blocked.confirm(x.before, x.comparison.fit)
-        current, loc = x.comparison.fit, relocate(x.comparison.fit)
+    made = exchanges(current, [f.mechanism for f in findings], round_comps, mechs, data, ctx,
+                     settings, chain_starts, relocate, say)
+    for x in made:
+        findings, current, loc = _exchanged(x, findings, mechs, data, ctx, v_orig, blocked,
+                                            relocate)
+    x = drift_exchange(current, [f.mechanism for f in findings], mechs, data, ctx, settings,
+                       chain_starts, loc, relocate, say) if findings else None
+    if x is not None:
+        findings, current, loc = _exchanged(x, findings, mechs, data, ctx, v_orig, blocked,
+                                            relocate)
     withdrawn: list[str] = []   # claims that the wider chain alone does as well as
     if findings:
         wider = challenge(current, baseline, rec_train, spec, settings, data, ctx, say,
@@ -388,38 +389,20 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
                                          'judged_holdout': _judged(data, baseline, current)})
 
 
-def gain_call(findings: list[Finding], final_loc: Localization, library: set[str]) -> None:
-    """Name a changing gain as a judgement call where an offset drift took its place.
-
-    A gain that changes about a zero far from the travel is mostly an offset
-    ramp: ``offset_drift`` can win its round, and the re-identified chain then
-    reaches the floor, while the final residual's trend still scales with the
-    output level (:data:`~hyst_id.diagnosis.locate.LEVEL_TREND_T`). On the blind
-    family's #64 (a 2.9 % gain growth about a zero five spans below the
-    travel) the time-gain block's own fit stopped at the slowest rate of its
-    search around the first chain, ``offset_drift`` took the round and ended
-    at 1.03 x the floor with the level term at t = 7.2. Whether a gain or an
-    offset drifts is then a judgement call, and the offset finding says so:
-    a growing trend names ``gain_drift``, a falling one ``supply_decay``
-    (pressure and flow) or ``gain_loss`` (position), where the channel's
-    library has it. Nothing changes when a time-gain
-    block is already a finding or the gain already one of the finding's
-    alternatives.
-    """
-    ids = {f.mechanism for f in findings}
-    level_t = float(final_loc.trend['level_t'])
-    if 'offset_drift' not in ids or abs(level_t) <= LEVEL_TREND_T:
-        return
-    gain = ('gain_drift' if level_t > 0
-            else 'supply_decay' if 'supply_decay' in library else 'gain_loss')
-    if gain not in library or ids & {'gain_drift', 'supply_decay', 'gain_loss'}:
-        return
-    f = next(f for f in findings if f.mechanism == 'offset_drift')
-    if gain in {a['mechanism'] for a in f.alternatives}:
-        return      # already named as tied or close (as under round-off probes 1 and 2 on #64)
-    f.alternatives = list(f.alternatives) + [{
-        'mechanism': gain, 'kind': 'signature', 'level_t': level_t,
-        'er_holdout_after_percent': f.er_holdout_after_percent}]
+def _exchanged(x: Exchange, findings: list[Finding], mechs: list[Mechanism], data: Data,
+               ctx: Context, v_orig: np.ndarray, blocked: BlockedCV,
+               relocate: Callable[[FitResult], Localization]
+               ) -> tuple[list[Finding], FitResult, Localization]:
+    """The findings, the model and its localization once ``x`` is made."""
+    mech = next(m for m in mechs if m.id == x.comparison.mechanism)
+    findings = list(findings)
+    old, findings[x.index] = findings[x.index], finding_from(
+        x.comparison, x.before, mech, relocate(x.before), ctx, v_orig)
+    findings[x.index].alternatives = [exchanged_call(x, data)] + [
+        a for a in old.alternatives if a['mechanism'] != mech.id
+        and a['mechanism'] not in x.stale]
+    findings[x.index].blocked_cv = blocked.confirm(x.before, x.comparison.fit)
+    return findings, x.comparison.fit, relocate(x.comparison.fit)
 
 
 def _rechosen_note(before: FitResult, after: FitResult, data: Data) -> str:

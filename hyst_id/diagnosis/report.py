@@ -59,13 +59,16 @@ def _alternative_lines(f: Any) -> list[str]:
                          'part better '
                          f'(judged {_fmt(a["er_judged_after_percent"])} for {a["mechanism"]})')
         if a.get('kind') == 'exchanged':
+            held = 'better' if a['holdout_z'] > 2.0 else 'as well'
+            fits = 'better' if a['delta_bic'] < 0.0 else 'about as well'
+            why = a.get('why', 'the two make the reading lag alike')
             lines.append(f'    {a["mechanism"]} took its round around the chain of that round; '
                          f'with the later blocks in, {f.mechanism} in its place fits the '
-                         f'training part better (delta BIC {a["delta_bic"]:.0f}) and predicts '
-                         f'the held-out part better (judged {_fmt(a["er_judged_chosen_percent"])} '
-                         f'against {_fmt(a["er_judged_after_percent"])}, z {a["holdout_z"]:.1f}):'
-                         ' the two make the reading lag alike, and the first round could not '
-                         'tell them apart')
+                         f'training part {fits} (delta BIC {a["delta_bic"]:.0f}) and predicts '
+                         f'the held-out part {held} (judged '
+                         f'{_fmt(a["er_judged_chosen_percent"])} against '
+                         f'{_fmt(a["er_judged_after_percent"])}, z {a["holdout_z"]:.1f}): '
+                         f'{why}, and the first round could not tell them apart')
         if a.get('kind') == 'split':
             cv = a['blocked_cv']
             lines.append(f'    a judgement call: {a["mechanism"]} was the choice of the judged '

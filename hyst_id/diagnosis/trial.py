@@ -44,7 +44,7 @@ from hyst_id.identification.domains import domains_from_data
 from hyst_id.identification.workers import map_in_processes, n_processes
 from hyst_id.io.recording import Recording
 
-__all__ = ['polish_all', 'try_all', 'try_mechanism']
+__all__ = ['judge', 'polish_all', 'try_all', 'try_mechanism']
 
 #: Mechanisms whose fits cost the most, handed to workers first (the rest keep their order).
 COSTLY_FIRST = ('loop_shape', 'actuator_dynamics', 'friction', 'bouc_wen', 'creep',
@@ -179,7 +179,7 @@ def try_mechanism(m: Mechanism, current: FitResult, data: Data, ctx: Context,
                 continue
             if fit is None or got.sse_train < fit.sse_train:
                 fit = got
-    return _judge(m, current, fit, data, ctx, settings, loc, screened)
+    return judge(m, current, fit, data, ctx, settings, loc, screened)
 
 
 def _as_twin(m: Mechanism, fit: FitResult, current: FitResult, data: Data, ctx: Context,
@@ -194,12 +194,12 @@ def _as_twin(m: Mechanism, fit: FitResult, current: FitResult, data: Data, ctx: 
                                         for pm in prev.mechanisms], ctx,
                           prev.bounds[:prev.n_chain], family=prev.spec.family.id,
                           swapped_by=prev.swapped_by, hold=prev.hold)
-    return _judge(m, current, evaluate(model, data, fit.p, fit.nfev), data, ctx, settings, loc)
+    return judge(m, current, evaluate(model, data, fit.p, fit.nfev), data, ctx, settings, loc)
 
 
-def _judge(m: Mechanism, current: FitResult, fit: FitResult, data: Data, ctx: Context,
-           settings: DiagnoseSettings, loc: Localization,
-           screened: FitResult | None = None) -> Comparison:
+def judge(m: Mechanism, current: FitResult, fit: FitResult, data: Data, ctx: Context,
+          settings: DiagnoseSettings, loc: Localization,
+          screened: FitResult | None = None) -> Comparison:
     """Judge ``fit`` (``current`` extended by ``m``): criteria, evidence, plausibility."""
     comp = compare(current, fit, data, m.id, settings.criteria)
     comp.screened = screened

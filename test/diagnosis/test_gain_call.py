@@ -26,7 +26,7 @@ from types import SimpleNamespace
 
 import pytest
 
-from hyst_id.diagnosis.driver import gain_call
+from hyst_id.diagnosis.exchange import gain_call
 from hyst_id.diagnosis.locate import LEVEL_TREND_T
 from hyst_id.diagnosis.report import _alternative_lines
 from hyst_id.diagnosis.result import Finding
