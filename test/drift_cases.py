@@ -22,23 +22,16 @@ gain growing about a distant zero, or through a drifting zero, with
 
 from __future__ import annotations
 
+from lag_cases import at_truth, NAMES, TRUTH
 import numpy as np
 from reference_sim import simulate as reference_simulate
 
-from hyst_id.diagnosis import DiagnoseSettings
-from hyst_id.diagnosis.locate import locate
-from hyst_id.diagnosis.mechanisms import Context, get_mechanisms
-from hyst_id.diagnosis.model import ComposedModel
-from hyst_id.diagnosis.select import Data, evaluate
+from hyst_id.diagnosis.mechanisms import get_mechanisms
 from hyst_id.diagnosis.trial import try_all
-from hyst_id.identification.chains import chain_spec
 from hyst_id.signals.excitation import multisine
-from hyst_id.signals.split import inside_rows
 
 __all__ = ['GROWTH', 'RAMP', 'ZERO_SPANS', 'forced_offset']
 
-NAMES = ('m_l', 'm_r', 'm_t', 'm_b', 'c_l', 'c_r', 'c_t', 'c_b', 'm_bl', 'c_bl', 'c_br')
-TRUTH = np.array([1.01, 1.05, 0.10, 0.15, -0.25, 0.50, 14.0, 7.0, 1.0, -0.15, 0.15])
 GROWTH = 0.04       # the gain's growth over the record
 ZERO_SPANS = 5.0    # the sensor's zero, in spans below the travel
 RAMP = 0.04         # the offset drift over the record, in spans
@@ -55,17 +48,7 @@ def forced_offset(drift: str, seed: int) -> dict:
         y = pivot + (x - pivot) * (1.0 + GROWTH * t / t[-1])
     else:
         y = x + RAMP * span * t / t[-1]
-    sigma = 0.004 * span
-    y = y + np.random.default_rng(seed).normal(0.0, sigma, t.size)
-    n = int(0.7 * t.size)
-    ctx = Context('position', t, n)
-    data = Data(t_s=t, v=v, y=y, n_train=n, noise_std=sigma, judged=inside_rows(v, n))
-    settings = DiagnoseSettings(fit_budget=300, workers=1)
-
-    def relocate(fit):
-        return locate(t, v, y, fit.prediction, sigma, n, None)
-    chain = evaluate(ComposedModel('position', [], ctx, chain_spec('position').bounds), data,
-                     TRUTH)
+    data, ctx, settings, relocate, chain = at_truth(t, v, y, 0.004 * span, seed)
     offset = try_all(get_mechanisms(('offset_drift',), channel='position'), chain, data, ctx,
                      settings, relocate(chain), [])[0]
     mechs = get_mechanisms(('offset_drift', 'gain_drift', 'gain_loss'), channel='position')

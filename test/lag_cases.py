@@ -25,6 +25,7 @@ from __future__ import annotations
 
 from pathlib import Path
 import sys
+from typing import Callable
 
 import numpy as np
 from reference_sim import first_order_sensor, simulate as reference_simulate
@@ -34,7 +35,7 @@ from hyst_id.diagnosis.exchange import LAGS
 from hyst_id.diagnosis.locate import locate
 from hyst_id.diagnosis.mechanisms import Context, get_mechanisms
 from hyst_id.diagnosis.model import ComposedModel
-from hyst_id.diagnosis.select import Data, evaluate
+from hyst_id.diagnosis.select import Data, evaluate, FitResult
 from hyst_id.diagnosis.trial import try_all
 from hyst_id.identification.chains import chain_spec
 from hyst_id.io.recording import Recording
@@ -44,7 +45,7 @@ from hyst_id.signals.split import inside_rows
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / 'bench'))
 import blind_family  # noqa: E402, I100
 
-__all__ = ['forced', 'mirror_of_24']
+__all__ = ['NAMES', 'TRUTH', 'at_truth', 'forced', 'mirror_of_24']
 
 NAMES = ('m_l', 'm_r', 'm_t', 'm_b', 'c_l', 'c_r', 'c_t', 'c_b', 'm_bl', 'c_bl', 'c_br')
 TRUTH = np.array([1.01, 1.05, 0.10, 0.15, -0.25, 0.50, 14.0, 7.0, 1.0, -0.15, 0.15])
@@ -63,7 +64,24 @@ def forced(lag: str, chosen: str, seed: int = 3) -> dict:
     span = float(np.ptp(x))
     x = x + 0.15 * span * ((x - float(np.min(x))) / span) ** 2
     y = first_order_sensor(t, x, 0.3) if lag == 'sensor_lag' else x
-    sigma = 0.004 * span
+    data, ctx, settings, relocate, chain = at_truth(t, v, y, 0.004 * span, seed)
+    curve = try_all(get_mechanisms(('static_nonlinearity',), channel='position'), chain,
+                    data, ctx, settings, relocate(chain), [])[0]
+    mechs = get_mechanisms(tuple(LAGS), channel='position')
+    second = try_all(mechs, curve.fit, data, ctx, settings, relocate(curve.fit), [])
+    final = next(c for c in second if c.mechanism == chosen).fit
+    return {'current': final, 'found': ['static_nonlinearity', chosen],
+            'rounds': {chosen: second}, 'mechs': mechs, 'data': data, 'ctx': ctx,
+            'settings': settings, 'chain_starts': [], 'relocate': relocate}
+
+
+def at_truth(t: np.ndarray, v: np.ndarray, y: np.ndarray, sigma: float, seed: int
+             ) -> tuple[Data, Context, DiagnoseSettings, Callable, FitResult]:
+    """``y`` with noise ``sigma`` (``seed``), split 70/30; the reference chain at its truth.
+
+    Returns the data, the context, small-budget settings, the residual's
+    localization for a fit, and the chain evaluated at :data:`TRUTH`.
+    """
     y = y + np.random.default_rng(seed).normal(0.0, sigma, t.size)
     n = int(0.7 * t.size)
     ctx = Context('position', t, n)
@@ -74,14 +92,7 @@ def forced(lag: str, chosen: str, seed: int = 3) -> dict:
         return locate(t, v, y, fit.prediction, sigma, n, None)
     chain = evaluate(ComposedModel('position', [], ctx, chain_spec('position').bounds), data,
                      TRUTH)
-    curve = try_all(get_mechanisms(('static_nonlinearity',), channel='position'), chain,
-                    data, ctx, settings, relocate(chain), [])[0]
-    mechs = get_mechanisms(tuple(LAGS), channel='position')
-    second = try_all(mechs, curve.fit, data, ctx, settings, relocate(curve.fit), [])
-    final = next(c for c in second if c.mechanism == chosen).fit
-    return {'current': final, 'found': ['static_nonlinearity', chosen],
-            'rounds': {chosen: second}, 'mechs': mechs, 'data': data, 'ctx': ctx,
-            'settings': settings, 'chain_starts': [], 'relocate': relocate}
+    return data, ctx, settings, relocate, chain
 
 
 def mirror_of_24(delay_samples: int = 2) -> Recording:
