@@ -103,6 +103,17 @@ def test_a_runner_up_within_the_tie_ratio_does_not(calls):
     assert chosen is w and len(record) == 2
 
 
+def test_a_winner_re_identified_into_implausible_values_keeps_its_local_fit(
+        calls, monkeypatch):
+    """A new user's gain_loss re-identified to its slowest rate was the verdict; not now."""
+    monkeypatch.setattr(refit, 'implausible_after',
+                        lambda c, data, ctx: 'at its slowest rate' if c.fit.judged == 0.3 else '')
+    w = _comp('gain_loss', 0.9, 0.3)
+    local = w.fit
+    chosen, record = _contest(w)
+    assert chosen is w and chosen.fit is local and calls == [0.9]
+
+
 def test_only_accepted_close_runners_up_contest_and_at_most_two(calls):
     w = _comp('a', 1.0, 5.0 * FLOOR)
     far = _comp('far', 2.5, 0.5 * FLOOR)                  # beyond CONTEST_RATIO
