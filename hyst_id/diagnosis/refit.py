@@ -221,9 +221,12 @@ def contest(winner, comps: list, data, ctx, spec: ChainSpec, settings, *,
     local_fit = winner.fit
     winner.fit = reidentify(winner.fit, data, ctx, spec, settings,
                             floor_train_percent=floor_train_percent, say=say)
-    if implausible_after(winner, data, ctx):
+    why = implausible_after(winner, data, ctx)
+    if why:
         # re-identified into values its physics cannot have (a new user's gain_loss at
         # the slowest rate of its search, an offset ramp): the accepted local fit stays
+        if say is not None:
+            say(f'{winner.mechanism} re-identified: {why}; its local fit stays')
         winner.fit = local_fit
     best_er = data.judged_er_percent(winner.fit)
     if best_er <= CONTEST_ABOVE * data.floor_holdout_percent:

