@@ -60,18 +60,20 @@ class GainDrift(TimeGain):
     def describe(self, theta, coef, info, ctx) -> dict[str, Quantity]:
         """Growth rate and the gain gained over the record."""
         r = float(theta[0])
-        return {'growth_percent_per_s': Quantity(100.0 * r, '%/s', 'gain growth rate'),
-                'gain_growth_percent': Quantity(100.0 * r * ctx.duration_s, '%',
-                                                'gain gained from the start to the end of '
-                                                'the record')}
+        return self.with_pivot({
+            'growth_percent_per_s': Quantity(100.0 * r, '%/s', 'gain growth rate'),
+            'gain_growth_percent': Quantity(100.0 * r * ctx.duration_s, '%',
+                                            'gain gained from the start to the end of the '
+                                            'record')}, info, ctx)
 
     def explain(self, values, where, ctx) -> str:
         """Words for a control engineer."""
         return (f'The gain grows with time: {values["gain_growth_percent"].value:.1f} % over '
                 f'the {ctx.duration_s:.0f} s record '
                 f'({values["growth_percent_per_s"].value:.3g} %/s): the same travel gives a '
-                'larger reading later in the run, as when a sensor or its amplifier warms '
-                'up. Let the sensor warm up before identifying, calibrate at operating '
+                'larger change of reading later in the run, as when a sensor or its amplifier '
+                'warms up.' + self.pivot_words(values, grows=True)
+                + ' Let the sensor warm up before identifying, calibrate at operating '
                 'temperature, or track the gain online (tracking in the compensator).')
 
 

@@ -67,19 +67,21 @@ class GainLoss(TimeGain):
     def describe(self, theta, coef, info, ctx) -> dict[str, Quantity]:
         """Loss rate and the gain lost over the record."""
         r = float(theta[0])
-        return {'loss_percent_per_s': Quantity(100.0 * r, '%/s', 'gain loss rate'),
-                'gain_loss_percent': Quantity(100.0 * r * ctx.duration_s, '%',
-                                              'gain lost from the start to the end of the '
-                                              'record')}
+        return self.with_pivot({
+            'loss_percent_per_s': Quantity(100.0 * r, '%/s', 'gain loss rate'),
+            'gain_loss_percent': Quantity(100.0 * r * ctx.duration_s, '%',
+                                          'gain lost from the start to the end of the '
+                                          'record')}, info, ctx)
 
     def explain(self, values, where, ctx) -> str:
         """Words for a control engineer."""
         return (f'The gain falls with time: {values["gain_loss_percent"].value:.1f} % over '
                 f'the {ctx.duration_s:.0f} s record '
-                f'({values["loss_percent_per_s"].value:.3g} %/s): the same command gives a '
-                f'smaller {ctx.quantity} reading later in the run, as when a voltage-driven '
-                "coil warms up (its current falls) or a sensor's magnet or gauge drifts. "
-                'Let the actuator and sensor warm up before identifying, drive the coil by '
+                f'({values["loss_percent_per_s"].value:.3g} %/s): the same command moves the '
+                f'{ctx.quantity} reading less later in the run, as when a voltage-driven '
+                "coil warms up (its current falls) or a sensor's magnet or gauge drifts."
+                + self.pivot_words(values, grows=False)
+                + ' Let the actuator and sensor warm up before identifying, drive the coil by '
                 'current, or track the gain online (tracking in the compensator).')
 
     def correction(self, theta, coef, info, ctx) -> dict[str, float | str]:

@@ -60,12 +60,13 @@ class SupplyDecay(TimeGain):
         """Time constant and the gain lost over the record."""
         lam = float(theta[0])
         loss = 1.0 - np.exp(-lam * ctx.duration_s)
-        return {'time_constant_s': Quantity(1.0 / lam, 's', 'e-folding time of the gain'),
-                'gain_loss_percent': Quantity(100.0 * loss, '%',
-                                              'gain lost from the start to the end of the '
-                                              'record'),
-                'gain_loss_percent_per_min': Quantity(100.0 * (1.0 - np.exp(-60.0 * lam)),
-                                                      '%/min', 'gain lost per minute')}
+        per_min = 100.0 * (1.0 - np.exp(-60.0 * lam))
+        return self.with_pivot({
+            'time_constant_s': Quantity(1.0 / lam, 's', 'e-folding time of the gain'),
+            'gain_loss_percent': Quantity(100.0 * loss, '%',
+                                          'gain lost from the start to the end of the record'),
+            'gain_loss_percent_per_min': Quantity(per_min, '%/min', 'gain lost per minute')},
+            info, ctx)
 
     def explain(self, values, where, ctx) -> str:
         """Words for a control engineer."""
@@ -73,7 +74,8 @@ class SupplyDecay(TimeGain):
                 f'over the {ctx.duration_s:.0f} s record (time constant '
                 f'{values["time_constant_s"].value:.0f} s), as when the supply vessels empty '
                 f'without pressure regulation: the same valve opening gives less {ctx.channel} '
-                'later in the run. Regulate the supply pressure, or schedule the gain on the '
+                'later in the run.' + self.pivot_words(values, grows=False)
+                + ' Regulate the supply pressure, or schedule the gain on the '
                 'measured supply pressure; an identification from an early run will '
                 'over-predict later ones.')
 

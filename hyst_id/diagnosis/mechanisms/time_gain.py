@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from hyst_id.diagnosis.mechanisms.base import Context, Mechanism
+from hyst_id.diagnosis.mechanisms.base import Context, Mechanism, Quantity
 
 __all__ = ['AT_SLOWEST', 'TimeGain']
 
@@ -68,6 +68,28 @@ class TimeGain(Mechanism):
     def null(self, ctx: Context) -> np.ndarray:
         """Slowest change (the block is then nearly the identity)."""
         return self.bounds(ctx)[:, 0].copy()
+
+    def with_pivot(self, values: dict[str, Quantity], info: dict,
+                   ctx: Context) -> dict[str, Quantity]:
+        """``values`` and the reading the changing gain leaves unchanged (``b1``)."""
+        pivot = float(info['coef'][info['labels'].index('offset')])
+        return {**values, 'unchanged_reading': Quantity(
+            pivot, ctx.meas_unit, 'the reading the changing gain leaves unchanged (its zero)')}
+
+    def pivot_words(self, values: dict[str, Quantity], grows: bool) -> str:
+        """Which way the readings move, from where the gain leaves them unchanged.
+
+        A gain changes every reading in proportion to its distance from that level:
+        a growing gain about a zero above the travel lowers the readings, which a
+        new user's report had called "a larger reading".
+        """
+        q = values.get('unchanged_reading')
+        if q is None:
+            return ''
+        up, down = ('rise', 'fall') if grows else ('fall', 'rise')
+        return (f' It acts about the reading {q.value:.4g} {q.unit}, the level the gain leaves '
+                f'unchanged: readings above it {up} over the run, readings below it {down}, '
+                'each in proportion to its distance from it.')
 
     def implausible(self, theta, coef, span, noise_std, ctx=None, labels=None) -> str:
         """A rate at the slowest end of its search is not a gain that changes.

@@ -1,0 +1,47 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""The words of a gain that changes in time say which way the readings move.
+
+A new user's gain growing about a zero above the travel lowered every reading,
+and the report said "the same travel gives a larger reading later"; the fitted
+zero (``b1``, the reading the gain leaves unchanged) was only in the JSON.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from hyst_id.diagnosis.mechanisms import Context, get_mechanisms
+
+__all__: list[str] = []
+
+T = np.arange(0.0, 100.0, 0.05)
+INFO = {'coef': np.array([2.0, -30.0, 128.0]), 'labels': ['gain_drift:0', 'gain', 'offset']}
+
+
+@pytest.mark.parametrize('mid, channel, grows', [('gain_drift', 'position', True),
+                                                 ('gain_loss', 'position', False),
+                                                 ('supply_decay', 'pressure', False)])
+def test_the_unchanged_reading_is_a_fitted_value_and_the_words_follow_it(mid, channel, grows):
+    """The zero is printed with the block, and the words say readings move about it."""
+    m = get_mechanisms((mid,), channel=channel)[0]
+    ctx = Context(channel, T, 1400)
+    values = m.describe(np.array([1e-3]), INFO['coef'], INFO, ctx)
+    assert values['unchanged_reading'].value == pytest.approx(128.0)
+    text = m.explain(values, None, ctx)
+    assert 'about the reading 128' in text
+    up, down = ('rise', 'fall') if grows else ('fall', 'rise')
+    assert f'readings above it {up} over the run, readings below it {down}' in text
