@@ -65,7 +65,10 @@ def test_an_offset_drift_is_kept(seed):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize('index, effect', [(34, 'gain_drift'), (89, 'offset_drift')])
+@pytest.mark.parametrize('index, effect', [
+    (34, 'gain_drift'),
+    # thorough tier: the forced offset drifts above already show one kept, in seconds
+    pytest.param(89, 'offset_drift', marks=pytest.mark.thorough)])
 def test_blind_drifts_end_with_their_own_block(index, effect):
     """#34: a gain drift that ``offset_drift`` took; #89: an offset drift, kept.
 
