@@ -330,7 +330,7 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
         findings, current, loc = _exchanged(x, findings, mechs, data, ctx, v_orig, blocked,
                                             relocate)
     x = drift_exchange(current, [f.mechanism for f in findings], mechs, data, ctx, settings,
-                       chain_starts, loc, relocate, say) if findings else None
+                       chain_starts, loc, relocate, say)
     if x is not None:
         findings, current, loc = _exchanged(x, findings, mechs, data, ctx, v_orig, blocked,
                                             relocate)

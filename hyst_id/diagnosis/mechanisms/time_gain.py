@@ -69,12 +69,17 @@ class TimeGain(Mechanism):
         """Slowest change (the block is then nearly the identity)."""
         return self.bounds(ctx)[:, 0].copy()
 
+    @staticmethod
+    def unchanged_reading(info: dict) -> float:
+        """The reading the gain leaves unchanged: the constant ``b1`` of the fit."""
+        return float(info['coef'][info['labels'].index('offset')])
+
     def with_pivot(self, values: dict[str, Quantity], info: dict,
                    ctx: Context) -> dict[str, Quantity]:
         """``values`` and the reading the changing gain leaves unchanged (``b1``)."""
-        pivot = float(info['coef'][info['labels'].index('offset')])
         return {**values, 'unchanged_reading': Quantity(
-            pivot, ctx.meas_unit, 'the reading the changing gain leaves unchanged (its zero)')}
+            self.unchanged_reading(info), ctx.meas_unit,
+            'the reading the changing gain leaves unchanged (its zero)')}
 
     def pivot_words(self, values: dict[str, Quantity], grows: bool) -> str:
         """Which way the readings move, from where the gain leaves them unchanged.
@@ -83,9 +88,7 @@ class TimeGain(Mechanism):
         a growing gain about a zero above the travel lowers the readings, which a
         new user's report had called "a larger reading".
         """
-        q = values.get('unchanged_reading')
-        if q is None:
-            return ''
+        q = values['unchanged_reading']
         up, down = ('rise', 'fall') if grows else ('fall', 'rise')
         return (f' It acts about the reading {q.value:.4g} {q.unit}, the level the gain leaves '
                 f'unchanged: readings above it {up} over the run, readings below it {down}, '
@@ -156,7 +159,7 @@ class TimeGain(Mechanism):
         record's mean gain, which becomes the schedule's reference.
         """
         rate = float(theta[0])
-        centre = float(info['coef'][info['labels'].index('offset')])
+        centre = self.unchanged_reading(info)
         mean_gain = float(np.mean(self.gain(rate, ctx.t_s - ctx.t_s[0])))
         return {'augment.gain_law': self.gain_law, 'augment.gain_rate_per_s': rate,
                 'augment.gain_centre': centre, 'augment.gain_reference': mean_gain}
