@@ -28,6 +28,12 @@ was answered, so a slow or busy machine only takes longer.
 The run starts when ``wait_for_subscribers`` subscribers are matched (then
 ``start_delay_s`` later) and ends after ``duration_s`` of profile time; with
 ``shutdown_when_done`` the process then exits 0.
+
+``min_command``/``max_command`` bound what the node may publish, in the
+output's units (mA on the command topic): a profile that leaves them over
+the run's samples is refused when set (the parameter change, or the node's
+start, fails with the first sample outside), and each published value is
+clipped to them as a last guard (counted, a ``/diagnostics`` WARN).
 """
 
 from __future__ import annotations
@@ -58,13 +64,18 @@ from hyst_id.signals.excitation import (
     make_excitation,
 )
 
-__all__ = ['Excitation', 'PARAMS', 'main', 'profile_kwargs']
+__all__ = ['CHECK_SAMPLES', 'Excitation', 'outside_limits', 'PARAMS', 'main', 'profile_kwargs']
 
 _NAN = math.nan
 #: Node parameter -> keyword of the profile functions in hyst_id.signals.excitation.
 _KWARGS = ('offset_ma', 'amplitude_ma', 'period_s', 'decay_per_s', 'frequencies_hz', 'f0_hz',
            'f1_hz', 'sweep_s', 'levels_ma', 'hold_s')
 _PROFILE_KEYS = ('profile',) + _KWARGS
+#: Parameters the profile's check against the command limits reads.
+_CHECKED_KEYS = _PROFILE_KEYS + ('min_command', 'max_command', 'duration_s', 'sample_period_s')
+#: The check evaluates at most this many of the run's samples (evenly spread over it; the
+#: clip at publication guards the others).
+CHECK_SAMPLES = 1_000_000
 
 PARAMS = [
     Param('profile', 'eq24', 'command profile (hyst_id.signals.excitation)',
@@ -86,6 +97,10 @@ PARAMS = [
           unit='s'),
     Param('sample_period_s', 0.1, 'profile time between samples', low=1e-4, high=1e4,
           unit='s'),
+    Param('min_command', -1e6, 'lowest value published (a profile below it is refused); '
+          'units of the output (mA on the command topic)', low=-1e6, high=1e6),
+    Param('max_command', 1e6, 'highest value published (a profile above it is refused); '
+          'units of the output (mA on the command topic)', low=-1e6, high=1e6),
     Param('time_scale', 1.0, 'profile seconds per wall-clock second', low=1e-3, high=1e4),
     Param('autostart', True, 'start by itself (else on request_start())', read_only=True),
     Param('wait_for_subscribers', 0, 'start only once this many subscribers are matched',
@@ -129,6 +144,29 @@ def _make_profile(values: dict[str, Any]) -> Callable[[float], float]:
     return lambda t_s: float(make_excitation(name, t_s, **kwargs))
 
 
+def outside_limits(values: dict[str, Any]) -> str:
+    """Words for the first run sample of the profile outside the command limits ('' if none).
+
+    The run's sample times ``k * sample_period_s`` up to ``duration_s`` are
+    evaluated (at most :data:`CHECK_SAMPLES` of them, evenly spread).
+    """
+    lo, hi = values['min_command'], values['max_command']
+    if not lo < hi:
+        return f'min_command ({lo:g}) must be below max_command ({hi:g})'
+    n = int(math.floor(values['duration_s'] / values['sample_period_s'] + 1e-9)) + 1
+    k = np.unique(np.linspace(0, n - 1, min(n, CHECK_SAMPLES)).round().astype(np.int64))
+    t_s = k * values['sample_period_s']
+    u = np.asarray(make_excitation(values['profile'], t_s, **profile_kwargs(values)),
+                   dtype=float)
+    bad = np.flatnonzero(~((u >= lo) & (u <= hi)))
+    if bad.size == 0:
+        return ''
+    i = int(bad[0])
+    return (f'profile {values["profile"]} leaves the command limits [{lo:g}, {hi:g}]: '
+            f'{u[i]:.6g} at t = {t_s[i]:.6g} s (range over the run {np.nanmin(u):.6g} to '
+            f'{np.nanmax(u):.6g}); change the profile or the limits')
+
+
 class Excitation(HystNode):
     """Publish a command profile sample by sample."""
 
@@ -137,7 +175,14 @@ class Excitation(HystNode):
         self._out = ScalarStream(self.p('topics.output_type'))
         self._pub = self.create_publisher(self._out.cls, self.p('topics.output_topic'),
                                           COMMAND_QOS, qos_overriding_options=OVERRIDABLE)
-        self._profile = _make_profile(self.param_values())
+        values = self.param_values()
+        self._profile = _make_profile(values)
+        problem = outside_limits(values)
+        if problem:
+            raise ConfigError(problem)
+        self._clipped = 0
+        #: the last value published (held where the profile gives a non-finite one)
+        self._last_sent = min(max(0.0, self.p('min_command')), self.p('max_command'))
         self._timer = None
         self._k = 0
         self._n_samples = 0
@@ -152,9 +197,10 @@ class Excitation(HystNode):
 
     # ---------------------------------------------------------------- params
     def validate_params(self, values: dict[str, Any], changed: set[str]) -> str | None:
-        if changed & set(_PROFILE_KEYS):
+        if changed & set(_CHECKED_KEYS):
             try:
                 _make_profile(values)
+                return outside_limits(values) or None
             except ConfigError as exc:
                 return str(exc)
         return None
@@ -238,13 +284,22 @@ class Excitation(HystNode):
         if self.ready is not None and not self.ready(self._k):
             return
         t_s = self._k * self.p('sample_period_s')
-        sample = self._out.make(self._profile(t_s), self.get_clock().now().to_msg()
+        value = self._profile(t_s)
+        lo, hi = self.p('min_command'), self.p('max_command')
+        if not lo <= value <= hi:     # between the checked samples of a very long run
+            self._clipped += 1
+            self.get_logger().warning(f'profile value {value:.6g} at t = {t_s:.6g} s clipped '
+                                      f'to [{lo:g}, {hi:g}] ({self._clipped} so far)',
+                                      throttle_duration_sec=1.0)
+            value = min(max(value, lo), hi) if math.isfinite(value) else self._last_sent
+        sample = self._out.make(value, self.get_clock().now().to_msg()
                                 if self._out.stamped else None)
         if not try_publish(self._pub, sample):
             self.get_logger().warning(f'sample {self._k} refused by the middleware (a '
                                       'subscriber stalled?): retrying it on the next tick',
                                       throttle_duration_sec=1.0)
             return
+        self._last_sent = value
         self._k += 1
 
     def _finish(self) -> None:
@@ -257,8 +312,12 @@ class Excitation(HystNode):
 
     def _status(self) -> None:
         t = self._k * self.p('sample_period_s')
-        self.publish_diagnostics(0, f'{self._state}: {self.p("profile")} t={t:.1f} s',
-                                 {'samples': self._k, 'profile': self.p('profile')})
+        clipped = (f'; {self._clipped} value(s) clipped to [{self.p("min_command"):g}, '
+                   f'{self.p("max_command"):g}]') if self._clipped else ''
+        self.publish_diagnostics(1 if self._clipped else 0,
+                                 f'{self._state}: {self.p("profile")} t={t:.1f} s{clipped}',
+                                 {'samples': self._k, 'profile': self.p('profile'),
+                                  'clipped': self._clipped})
 
 
 def main(args: list[str] | None = None) -> int:

@@ -138,6 +138,10 @@ def test_defaults_match_the_params_files():
     (ActuatorDriver, {'m_b': 1.5}, 'm_b'),
     (Excitation, {'profile': 'square'}, 'one of'),
     (Excitation, {'hold_s': -1.0}, 'hold_s'),
+    # eq24 (9 +- 2 mA, decaying) peaks at 10.99 mA: a limit of 10.5 refuses it
+    (Excitation, {'max_command': 10.5}, 'leaves the command limits [-1e+06, 10.5]'),
+    (Excitation, {'min_command': 12.0, 'max_command': 11.0}, 'must be below max_command'),
+    (Excitation, {'profile': 'steps', 'min_command': 7.2}, 'leaves the command limits'),
     (Identifier, {'domains': '/no/such/domains.yaml'}, 'domains'),
     (Identifier, {'pop_size': 1}, 'pop_size'),
     (Identifier, {'hops': -1}, 'hops'),
@@ -505,6 +509,41 @@ def test_excitation_publishes_the_profile_samples(ctx):
     sink.create_subscription(Float64, '/hyst_id/command', lambda m: got.append(m.data), 100)
     assert _spin_until(ctx, [exc, sink], lambda: exc.finished and len(got) == 21)
     np.testing.assert_allclose(got, eq24(np.arange(21) * 0.1), rtol=0, atol=1e-15)
+
+
+def test_excitation_refuses_a_profile_outside_its_command_limits(ctx):
+    """A start that would publish outside min/max_command fails with the sample; inside runs."""
+    with pytest.raises(ConfigError, match=r'leaves the command limits \[8, 10\]: .* at t ='):
+        Excitation(context=ctx[0], parameter_overrides=[
+            Parameter('min_command', value=8.0), Parameter('max_command', value=10.0)])
+    exc = _make(ctx, Excitation, parameter_overrides=[
+        Parameter('min_command', value=6.9), Parameter('max_command', value=11.1),
+        Parameter('duration_s', value=2.0), Parameter('time_scale', value=100.0),
+        Parameter('wait_for_subscribers', value=1)])
+    assert not _set(exc, amplitude_ma=3.0).successful      # 9 +- 3 leaves [6.9, 11.1]
+    got = []
+    sink = _make(ctx, Node, 'sink')
+    sink.create_subscription(Float64, '/hyst_id/command', lambda m: got.append(m.data), 100)
+    assert _spin_until(ctx, [exc, sink], lambda: exc.finished and len(got) == 21)
+    np.testing.assert_allclose(got, eq24(np.arange(21) * 0.1), rtol=0, atol=1e-15)
+
+
+def test_excitation_clips_a_value_between_its_checked_samples(ctx, monkeypatch):
+    """The last guard: a value outside the limits (unchecked sample) goes out clipped, WARN."""
+    exc = _make(ctx, Excitation, parameter_overrides=[
+        Parameter('max_command', value=11.0), Parameter('duration_s', value=0.5),
+        Parameter('time_scale', value=100.0), Parameter('wait_for_subscribers', value=1)])
+    monkeypatch.setattr(exc, '_profile', lambda t_s: 12.0 if t_s > 0.25 else 9.0)
+    status = []
+    monkeypatch.setattr(exc, 'publish_diagnostics',
+                        lambda level, msg, values=None: status.append((level, msg)))
+    got = []
+    sink = _make(ctx, Node, 'sink')
+    sink.create_subscription(Float64, '/hyst_id/command', lambda m: got.append(m.data), 100)
+    assert _spin_until(ctx, [exc, sink], lambda: exc.finished and len(got) == 6)
+    assert got == [9.0, 9.0, 9.0, 11.0, 11.0, 11.0]
+    exc._status()
+    assert status[-1][0] == 1 and '3 value(s) clipped to [-1e+06, 11]' in status[-1][1]
 
 
 def test_recorder_writes_a_readable_bag(ctx, tmp_path):
