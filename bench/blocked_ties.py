@@ -48,7 +48,7 @@ from hyst_id.diagnosis import diagnose, DiagnoseSettings  # noqa: E402
 from hyst_id.diagnosis.blocked_cv import (  # noqa: E402
     block_predictions, compare_blocked, SPLIT_MINORITY)
 import hyst_id.diagnosis.driver as driver  # noqa: E402, I100
-from hyst_id.diagnosis.select import choose, close_calls  # noqa: E402
+from hyst_id.diagnosis.ties import choose, close_calls  # noqa: E402
 from hyst_id.io.recording import Recording  # noqa: E402
 from hyst_id.signals.split import inside_rows, split_index  # noqa: E402
 

@@ -68,18 +68,10 @@ from hyst_id.diagnosis.mechanisms import get_mechanisms
 from hyst_id.diagnosis.mechanisms.base import Context, Mechanism
 from hyst_id.diagnosis.refit import contest
 from hyst_id.diagnosis.result import DiagnoseSettings, Diagnosis, Finding
-from hyst_id.diagnosis.select import (
-    alternatives_record,
-    choose,
-    close_calls,
-    Comparison,
-    Data,
-    FitResult,
-    hold_calls,
-    round_record,
-)
+from hyst_id.diagnosis.select import Comparison, Data, FitResult, round_record
 from hyst_id.diagnosis.split_notes import level_note, range_note, require_split, swing_note
 from hyst_id.diagnosis.start_cut import start_cut
+from hyst_id.diagnosis.ties import alternatives_record, choose, close_calls, hold_calls
 from hyst_id.diagnosis.trial import try_all
 from hyst_id.errors import ConfigError
 from hyst_id.identification.chains import chain_spec, ChainSpec
@@ -122,7 +114,8 @@ def _info(fit: FitResult, ctx: Context, command: np.ndarray) -> dict:
         pos_per_cmd = float(np.ptp(fit.travel_raw) / max(float(np.ptp(command)), 1e-300))
     return {'coef': fit.coef, 'labels': fit.labels, 'span': fit.span, 'x_chain': x_chain,
             'to_meas': to_meas, 'meas_per_pos': float((ends[1] - ends[0]) / (hi - lo)),
-            'pos_per_cmd': pos_per_cmd, 'command': command, 'travel_raw': fit.travel_raw}
+            'pos_per_cmd': pos_per_cmd, 'command': command, 'travel_raw': fit.travel_raw,
+            'readings_median': float(np.median(fit.prediction[:ctx.n_train]))}
 
 
 def located_where(loc: Localization, own: dict) -> dict:

@@ -84,6 +84,8 @@ def _alternative_lines(f: Any) -> list[str]:
     if tied:
         lines.append('    also consistent with the data (tied, decided by training BIC '
                      f'and evidence): {_alts(tied)}')
+    lines.extend(f'    {a["mechanism"]} stood back in the tie: {a["doubt"]}'
+                 for a in tied if a.get('doubt'))
     if close:
         lines.append(f'    a judgement call: {_alts(close)} explain it nearly as well '
                      f'(held-out {_fmt(f.er_holdout_after_percent)} for {f.mechanism}); '

@@ -26,7 +26,7 @@ Linear parameters are profiled on the training samples
 (:mod:`hyst_id.diagnosis.model`), and the result is never worse on the
 training part than the model it extends.
 
-Deciding (:func:`compare`, :func:`choose`): a block is *accepted* over the
+Deciding (:func:`compare`, :func:`hyst_id.diagnosis.ties.choose`): a block is *accepted* over the
 current model only when
 
 * the information criterion on the training part drops by more than
@@ -44,9 +44,9 @@ Among accepted blocks the lowest held-out error wins; blocks whose
 held-out %e_r is within ``tie_ratio`` (10 %) of the best, or within
 ``tie_floor`` (1.25) x the noise floor when the best is too, or not
 significantly worse (``z < 2`` against the best) are tied, and the training
-BIC decides among them, then the located evidence. Accepted runners-up within
-``judgement_ratio`` (1.25) of the winner's held-out error are reported with
-the finding as a judgement call (:func:`close_calls`).
+BIC decides among them, then the located evidence (:mod:`hyst_id.diagnosis.ties`).
+Accepted runners-up within ``judgement_ratio`` (1.25) of the winner's held-out
+error are reported with the finding as a judgement call.
 """
 
 from __future__ import annotations
@@ -61,9 +61,7 @@ from hyst_id.diagnosis.model import ComposedModel, solve_linear
 from hyst_id.identification.chains import er_percent
 
 __all__ = ['Criteria', 'Data', 'FitResult', 'Comparison', 'evaluate', 'fit_model', 'polish',
-           'compare', 'choose', 'close_calls', 'alternatives_record', 'explained_share',
-           'HOLD_CALL_SAMPLES', 'NESTS', 'hold_calls',
-           'improvement_z', 'passes_holdout', 'round_record']
+           'compare', 'explained_share', 'improvement_z', 'passes_holdout', 'round_record']
 
 
 @dataclass(frozen=True)
@@ -78,7 +76,7 @@ class Criteria:
     tie_ratio: float = 1.1
     tie_floor: float = 1.25
     #: accepted runners-up within this ratio of the winner's judged held-out %e_r are
-    #: reported as a judgement call (:func:`close_calls`). On the paper rig's pressure
+    #: reported as a judgement call (``ties.close_calls``). On the paper rig's pressure
     #: run the other drift block came 1.12-3.3 x the winner's over four round-off probes
     #: (1.22-3.2 x at 5b82421; ``bench/rig_diagnosis_roundoff.py``): 1.25 names the
     #: closest case; it cannot make a runner-up whose own fit moves with round-off stable
@@ -167,6 +165,9 @@ class Comparison:
     #: a filter block's fit in the ``after`` hold that was dropped as a one-sample delay
     #: in disguise (:func:`hyst_id.diagnosis.trial.try_mechanism`), kept for the report
     screened: FitResult | None = None
+    #: why the fit goes against the block's own physics (:meth:`~hyst_id.diagnosis.mechanisms.
+    #: base.Mechanism.doubt`); in a tie it steps back (:func:`hyst_id.diagnosis.ties.choose`)
+    doubt: str = ''
 
 
 def evaluate(model: ComposedModel, data: Data, p: np.ndarray, nfev: int = 0) -> FitResult:
@@ -398,111 +399,6 @@ def passes_holdout(comp: Comparison, criteria: Criteria) -> bool:
             and comp.share >= criteria.min_share)
 
 
-#: Blocks that nest another (a falling gain about a distant zero is an offset ramp): while the
-#: nested one is accepted and within the judgement ratio, one wins only with its own located
-#: evidence (> 0). Blind #118 and #38, offset drifts, went to ``gain_loss`` without this.
-NESTS = {'gain_loss': 'offset_drift'}
-
-
-def choose(comparisons: list[Comparison], data: Data, criteria: Criteria
-           ) -> tuple[Comparison | None, list[Comparison]]:
-    """Pick the accepted candidate: held-out error, then BIC among ties, then evidence.
-
-    A nesting block without evidence steps back (:data:`NESTS`). Returns the winner (None
-    when nothing is accepted) and the others tied with it (equally consistent with the data).
-    """
-    ok = [c for c in comparisons if c.accepted]
-    if not ok:
-        return None, []
-    er = {id(c): data.judged_er_percent(c.fit) for c in ok}
-    mine = {c.mechanism: c for c in ok}
-    ok = [c for c in ok if not ((m := mine.get(NESTS.get(c.mechanism))) and c.evidence <= 0.0
-                                and er[id(m)] <= criteria.judgement_ratio * er[id(c)])]
-    best = min(ok, key=lambda c: er[id(c)])
-    rows = data.judged_rows
-    near = max(criteria.tie_ratio * er[id(best)],
-               criteria.tie_floor * data.floor_holdout_percent)
-    tied = [c for c in ok if c is best or er[id(c)] <= near
-            or improvement_z(c.fit.prediction[rows], best.fit.prediction[rows], data.y[rows],
-                             data.noise_std) < criteria.tie_z]
-    n = data.n_train
-    bics = {c.mechanism: c.fit.bic(n) for c in tied}
-    low = min(bics.values())
-    close = [c for c in tied if bics[c.mechanism] < low + 2.0]
-    winner = max(close, key=lambda c: (c.evidence, -bics[c.mechanism]))
-    return winner, [c for c in tied if c is not winner]
-
-
-def close_calls(comparisons: list[Comparison], winner: Comparison | None,
-                tied: list[Comparison], data: Data, criteria: Criteria) -> list[Comparison]:
-    """Accepted runners-up, not tied, close enough to the winner to make it a judgement call.
-
-    Their judged held-out %e_r is within ``criteria.judgement_ratio`` of the
-    winner's: the data prefer the winner, but by less than round-off, the
-    split or a slightly different record could reverse; a report names them.
-    """
-    if winner is None:
-        return []
-    best = data.judged_er_percent(winner.fit)
-    return [c for c in comparisons if c.accepted and c is not winner
-            and all(c is not t for t in tied)
-            and data.judged_er_percent(c.fit) <= criteria.judgement_ratio * best]
-
-
-#: :func:`hold_calls` only for a dead time up to this many sample periods: the screen
-#: drops ``after``-hold lags below about 1.44 samples (``a > 0.5``), so such a lag and its
-#: hold delay the reading by at most about 2.4 samples on average; 3 leaves a margin
-HOLD_CALL_SAMPLES = 3.0
-
-
-def hold_calls(winner: Comparison, comps: list[Comparison], data: Data,
-               criteria: Criteria, dt_s: float) -> list[dict]:
-    """Filters behind a one-sample hold that a winning dead time stands for as well.
-
-    On a static chain a filter block fitted in the ``after`` hold is dropped
-    when it changes its input less than the hold's one-sample shift does
-    (:func:`hyst_id.diagnosis.trial.try_mechanism`): it is mostly a delay.
-    But a first-order lag of about a sample behind such a hold (the reference
-    simulator's convention, a rig sampled before the new command acts) is also
-    mostly a delay: on the blind family's #134 (a 0.5-sample lag) ``dead_time``
-    won with 1.2 samples and the dropped lag fit was as good on held-out data
-    (on #84, a 1.4-sample lag, it was not: fitted around a biased chain). When the winner is
-    ``dead_time`` and such a dropped fit predicts the judged held-out samples
-    within ``criteria.judgement_ratio`` of it, the report names it (``kind``
-    ``hold``). Only for delays up to :data:`HOLD_CALL_SAMPLES` sample periods:
-    a longer delay is not what a sub-sample lag behind a hold looks like
-    (``dt_s``: the sample period, :attr:`~hyst_id.diagnosis.mechanisms.base.Context.dt_s`).
-    """
-    if winner.mechanism != 'dead_time':
-        return []
-    model = winner.fit.model
-    if model is None or model.theta(winner.fit.p, 'dead_time')[0] > HOLD_CALL_SAMPLES * dt_s:
-        return []
-    best = data.judged_er_percent(winner.fit)
-    out = []
-    for c in comps:
-        if c.screened is None:
-            continue
-        er = data.judged_er_percent(c.screened)
-        if er <= criteria.judgement_ratio * best:
-            out.append({'mechanism': c.mechanism, 'kind': 'hold',
-                        'er_holdout_after_percent': c.screened.er_holdout_percent,
-                        'er_judged_after_percent': er})
-    return out
-
-
-def alternatives_record(tied: list[Comparison], close: list[Comparison],
-                        data: Data) -> list[dict]:
-    """A finding's ``alternatives``: tied candidates, then close calls, with which they are.
-
-    Each with its held-out %e_r (all held-out rows) and the judged one the
-    criteria compare (:attr:`Data.judged_rows`).
-    """
-    return [{'mechanism': c.mechanism, 'er_holdout_after_percent': c.fit.er_holdout_percent,
-             'er_judged_after_percent': data.judged_er_percent(c.fit), 'kind': kind}
-            for kind, group in (('tied', tied), ('close', close)) for c in group]
-
-
 def round_record(round_no: int, comps: list[Comparison], winner: Comparison | None,
                  data: Data | None = None) -> dict:
     """JSON record of one selection round: every candidate with its criteria."""
@@ -514,7 +410,7 @@ def round_record(round_no: int, comps: list[Comparison], winner: Comparison | No
          else c.fit.er_holdout_percent, 'delta_bic': c.delta_bic,
          'holdout_z': c.holdout_z, 'holdout_gain': c.gain, 'explained_share': c.share,
          'evidence': c.evidence,
-         # the after-hold fit the screen dropped (hold_calls), when there was one
+         # the after-hold fit the screen dropped (ties.hold_calls), when there was one
          'er_judged_screened_percent': None if c.screened is None or data is None
          else data.judged_er_percent(c.screened)}
         for c in comps]}

@@ -56,18 +56,10 @@ from hyst_id.diagnosis.driver import located_where
 from hyst_id.diagnosis.locate import Localization, locate, noise_std
 from hyst_id.diagnosis.mechanisms import MECHANISMS, Quantity
 from hyst_id.diagnosis.result import DiagnoseSettings, Diagnosis, Finding
-from hyst_id.diagnosis.select import (
-    alternatives_record,
-    choose,
-    close_calls,
-    compare,
-    Comparison,
-    Data,
-    FitResult,
-    round_record,
-)
+from hyst_id.diagnosis.select import compare, Comparison, Data, FitResult, round_record
 from hyst_id.diagnosis.split_notes import range_note, require_split
 from hyst_id.diagnosis.stick_events import bands_from_demand
+from hyst_id.diagnosis.ties import alternatives_record, choose, close_calls
 from hyst_id.errors import ConfigError, HystIdError
 from hyst_id.identification.chains import er_percent
 from hyst_id.io.recording import Recording, roundoff_probe, validate_recording

@@ -207,6 +207,7 @@ def judge(m: Mechanism, current: FitResult, fit: FitResult, data: Data, ctx: Con
     model = fit.model
     theta = model.theta(fit.p, m.id) if m.id in model.slices else np.zeros(0)
     reason = m.implausible(theta, fit.coef, fit.span, data.noise_std, ctx, labels=fit.labels)
+    comp.doubt = m.doubt(theta, fit.coef, fit.labels, data.y[:data.n_train])
     if reason and comp.accepted:
         comp.accepted, comp.status = False, f'rejected: {reason}'
     return comp

@@ -63,7 +63,7 @@ def test_an_offset_drift_is_not_taken_by_a_gain_loss_without_its_signature():
 
     ``gain_loss`` nests an offset ramp and fitted the held-out part better around the first
     chain (0.112 against 0.129 %e_r); without a trend that scales with the level it steps
-    back (``select.NESTS``) and is the stated call. Held under round-off probes 1 and 2.
+    back (``ties.NESTS``) and is the stated call. Held under round-off probes 1 and 2.
     """
     case = blind_family.draw(118)
     assert case['effects'] == ['offset_drift'] and case['channel'] == 'position'

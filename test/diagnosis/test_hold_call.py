@@ -28,7 +28,8 @@ import numpy as np
 
 from hyst_id.diagnosis.report import _alternative_lines
 from hyst_id.diagnosis.result import Finding
-from hyst_id.diagnosis.select import Criteria, HOLD_CALL_SAMPLES, hold_calls
+from hyst_id.diagnosis.select import Criteria
+from hyst_id.diagnosis.ties import HOLD_CALL_SAMPLES, hold_calls
 
 DT_S = 0.1
 DATA = SimpleNamespace(judged_er_percent=lambda fit: fit.er)

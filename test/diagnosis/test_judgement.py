@@ -27,15 +27,8 @@ from types import SimpleNamespace
 import numpy as np
 
 from hyst_id.diagnosis.report import _alternative_lines
-from hyst_id.diagnosis.select import (
-    alternatives_record,
-    choose,
-    close_calls,
-    Comparison,
-    Criteria,
-    Data,
-    FitResult,
-)
+from hyst_id.diagnosis.select import Comparison, Criteria, Data, FitResult
+from hyst_id.diagnosis.ties import alternatives_record, choose, close_calls
 
 __all__: list[str] = []
 
@@ -91,6 +84,41 @@ def test_the_report_names_the_close_call():
     assert 'also consistent' not in text
     finding.alternatives = alternatives_record([comps[1]], [], data)      # a tie instead
     assert 'also consistent with the data' in '\n'.join(_alternative_lines(finding))
+
+
+def test_a_tied_fit_against_its_own_physics_steps_back_and_the_report_says_why():
+    """A tied candidate with a doubt does not win over one without; alone it still can."""
+    data = _data()
+    crit = Criteria()
+    decay = _comparison(data, 'supply_decay', 1.0, bic_sse=0.5)      # best BIC, held-out
+    grow = _comparison(data, 'gain_drift', 1.02)
+    decay.doubt = 'most readings would rise as the supply runs down'
+    winner, tied = choose([decay, grow], data, crit)
+    assert winner is grow and tied == [decay]
+    finding = SimpleNamespace(mechanism='gain_drift', er_holdout_after_percent=1.02,
+                              alternatives=alternatives_record(tied, [], data))
+    assert finding.alternatives[0]['doubt'] == decay.doubt
+    assert ('supply_decay stood back in the tie: most readings would rise as the supply runs '
+            'down') in '\n'.join(_alternative_lines(finding))
+    decay.evidence = 1.0                            # evidence does not override the doubt
+    assert choose([decay, grow], data, crit)[0] is grow
+    assert choose([decay], data, crit)[0] is decay  # no tied rival: the fit stands
+    far = _comparison(data, 'gain_drift', 1.5)      # not tied: the better held-out wins
+    assert choose([decay, far], data, crit)[0] is decay
+    grow.doubt = 'another doubt'                    # every tied one doubted: as before
+    assert choose([decay, grow], data, crit)[0] is decay
+
+
+def test_supply_decay_doubts_a_fit_whose_readings_rise():
+    """The reading the decaying gain leaves unchanged above most readings: they would rise."""
+    from hyst_id.diagnosis.mechanisms.supply_decay import MECHANISM as decay
+    readings = np.linspace(1068.0, 1194.0, 50)
+    labels = ['sensor', 'supply_decay:0', 'offset']
+    assert 'above the middle of the readings' in decay.doubt(
+        np.array([1e-4]), np.array([1.0, 0.0, 2826.0]), labels, readings)
+    assert decay.doubt(np.array([1e-4]), np.array([1.0, 0.0, 364.0]), labels, readings) == ''
+    from hyst_id.diagnosis.mechanisms.gain_drift import MECHANISM as drift
+    assert drift.doubt(np.array([1e-4]), np.array([1.0, 0.0, 2826.0]), labels, readings) == ''
 
 
 def test_diagnostics_carry_the_judgement_call():

@@ -45,3 +45,18 @@ def test_the_unchanged_reading_is_a_fitted_value_and_the_words_follow_it(mid, ch
     assert 'about the reading 128' in text
     up, down = ('rise', 'fall') if grows else ('fall', 'rise')
     assert f'readings above it {up} over the run, readings below it {down}' in text
+
+
+@pytest.mark.parametrize('middle, doubted', [(100.0, True), (150.0, False), (None, False)])
+def test_a_supply_decay_whose_readings_rise_says_so(middle, doubted):
+    """Unchanged reading 128 above the readings' middle: a judgement call in the words."""
+    m = get_mechanisms(('supply_decay',), channel='pressure')[0]
+    ctx = Context('pressure', T, 1400)
+    info = dict(INFO) if middle is None else {**INFO, 'readings_median': middle}
+    values = m.describe(np.array([1e-3]), INFO['coef'], info, ctx)
+    text = m.explain(values, None, ctx)
+    assert ('middle_reading' in values) is doubted
+    assert ('so most readings would rise as the supply runs down' in text) is doubted
+    if doubted:
+        assert values['middle_reading'].value == 100.0
+        assert 'a judgement call against a gain growing or an offset drifting' in text

@@ -230,6 +230,16 @@ class Mechanism:
         """
         return ''
 
+    def doubt(self, theta: np.ndarray, coef: np.ndarray, labels: Sequence[str],
+              readings: np.ndarray) -> str:
+        """Why the fit, though possible, goes against the block's own physics ('' if not).
+
+        Not a rejection: among candidates tied on the held-out part, one with
+        a doubt steps back for one without (:func:`hyst_id.diagnosis.ties.choose`),
+        and the report says why. ``readings``: the training part's measurement.
+        """
+        return ''
+
     # -- stage hooks (identity by default) ----------------------------------
     def command(self, theta: np.ndarray, t_s: np.ndarray, v: np.ndarray) -> np.ndarray:
         """Transform the command before the actuator."""

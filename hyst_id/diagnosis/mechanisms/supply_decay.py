@@ -26,6 +26,15 @@ parameter, so the block adds one searched parameter ``T`` and one linear.
 Signature: a residual trend over time whose size scales with the output
 level (the loop shrinks), unlike an offset drift, which shifts every level
 alike.
+
+Direction: a supply running down lowers every pressure and flow above
+ambient, so a direct-reading sensor's readings fall toward the reading of
+zero (the level the gain leaves unchanged). A fit that puts that level above
+most readings has them rise as the supply falls, which needs a sensor whose
+reading falls as the quantity rises; in a tie such a fit steps back
+(:meth:`SupplyDecay.doubt`). Blind #157 (a sensitivity growing 4.6 % about a
+zero below the travel) had been named ``supply_decay`` about a zero 13 spans
+above it, tied with ``gain_drift`` and ``offset_drift``.
 """
 
 from __future__ import annotations
@@ -36,6 +45,15 @@ from hyst_id.diagnosis.mechanisms.base import Quantity
 from hyst_id.diagnosis.mechanisms.time_gain import TimeGain
 
 __all__ = ['SupplyDecay', 'MECHANISM']
+
+
+def _rising(zero: float, middle: float) -> str:
+    """Words for an unchanged reading ``zero`` above the readings' ``middle`` ('' if not)."""
+    if not zero > middle:
+        return ''
+    return (f'the reading it leaves unchanged ({zero:.4g}) lies above the middle of the '
+            f'readings ({middle:.4g}), so most readings would rise as the supply runs down, '
+            'which a sensor whose reading rises with the pressure or flow does not do')
 
 
 class SupplyDecay(TimeGain):
@@ -56,17 +74,28 @@ class SupplyDecay(TimeGain):
         """Exponential decay ``exp(-rate t)``."""
         return np.exp(-rate * elapsed_s)
 
+    def doubt(self, theta, coef, labels, readings) -> str:
+        """Readings that rise as the supply falls: the unchanged reading above their median."""
+        return _rising(self.unchanged_reading({'coef': coef, 'labels': list(labels)}),
+                       float(np.median(readings)))
+
     def describe(self, theta, coef, info, ctx) -> dict[str, Quantity]:
         """Time constant and the gain lost over the record."""
         lam = float(theta[0])
         loss = 1.0 - np.exp(-lam * ctx.duration_s)
         per_min = 100.0 * (1.0 - np.exp(-60.0 * lam))
-        return self.with_pivot({
+        values = self.with_pivot({
             'time_constant_s': Quantity(1.0 / lam, 's', 'e-folding time of the gain'),
             'gain_loss_percent': Quantity(100.0 * loss, '%',
                                           'gain lost from the start to the end of the record'),
             'gain_loss_percent_per_min': Quantity(per_min, '%/min', 'gain lost per minute')},
             info, ctx)
+        middle = info.get('readings_median')
+        if middle is not None and _rising(values['unchanged_reading'].value, middle):
+            values['middle_reading'] = Quantity(
+                middle, ctx.meas_unit, "the middle of the training part's readings, below the "
+                'unchanged one: most readings rise as the gain falls')
+        return values
 
     def explain(self, values, where, ctx) -> str:
         """Words for a control engineer."""
@@ -77,7 +106,11 @@ class SupplyDecay(TimeGain):
                 'later in the run.' + self.pivot_words(values, grows=False)
                 + ' Regulate the supply pressure, or schedule the gain on the '
                 'measured supply pressure; an identification from an early run will '
-                'over-predict later ones.')
+                'over-predict later ones.' + (
+                    ' But ' + _rising(values['unchanged_reading'].value,
+                                      values['middle_reading'].value)
+                    + ': a judgement call against a gain growing or an offset drifting.'
+                    if 'middle_reading' in values else ''))
 
 
 MECHANISM = SupplyDecay()
