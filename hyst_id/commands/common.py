@@ -197,6 +197,14 @@ _INPUTS = ('recording', 'params', 'sim', 'domains')
 _OUTPUTS = ('json', 'params_out', 'sim_out', 'plot')
 
 
+def _same_file(a: Path, b: Path) -> bool:
+    """Whether ``a`` and ``b`` are one file (a hard link is another name for it)."""
+    try:
+        return a.is_file() and b.is_file() and a.samefile(b)
+    except OSError:
+        return False
+
+
 def _refuse_overwriting_inputs(args: argparse.Namespace) -> None:
     """A :class:`ConfigError` when an output would overwrite an input or another output.
 
@@ -214,7 +222,8 @@ def _refuse_overwriting_inputs(args: argparse.Namespace) -> None:
         flag, out = '--' + opt.replace('_', '-'), Path(value).resolve()
         for src in inputs:
             here = src.resolve()
-            if out == here or (here.is_dir() and out.is_file() and here in out.parents):
+            if out == here or _same_file(out, here) or (
+                    here.is_dir() and out.is_file() and here in out.parents):
                 what = f'the input {src}' if out == here else f'a file of the input {src}'
                 raise ConfigError(f'{flag} {value}: that is {what}, which the output would '
                                   'overwrite; give another file name')

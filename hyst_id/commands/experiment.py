@@ -34,6 +34,7 @@ from hyst_id.commands.common import progress_bar
 from hyst_id.diagnosis import DiagnoseSettings
 from hyst_id.errors import ConfigError
 from hyst_id.identification import IdentifySettings
+from hyst_id.io.outputs import make_output_folder
 
 __all__ = ['add_arguments', 'run', 'QUICK_DIAGNOSIS', 'QUICK_SETTINGS', 'DEFAULT_PARAMS']
 
@@ -120,6 +121,9 @@ def run(args: argparse.Namespace) -> int:
     modes = ('gaass',) if args.gaass_only else MODES
     command = _command_line(args)
     params = _params_path(args.params)
+    make_output_folder(Path(args.out), '--out', args.out)      # before the work, not after
+    if args.copy_figures:
+        make_output_folder(Path(args.copy_figures), '--copy-figures', args.copy_figures)
     print(f'{command}\nrig {params}; regulation {args.regulation}; modes {", ".join(modes)}; '
           f'{n_seeds} seeds', file=sys.stderr)
     bar = None
@@ -146,7 +150,6 @@ def run(args: argparse.Namespace) -> int:
     print(markdown.split('## %e_r (Eq. 7)')[0].rstrip())
     if args.copy_figures:
         dest = Path(args.copy_figures)
-        dest.mkdir(parents=True, exist_ok=True)
         for name, path in paths.items():
             if path.suffix == '.png' and name != 'fig2':
                 shutil.copy2(path, dest / path.name)

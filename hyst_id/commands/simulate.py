@@ -65,17 +65,42 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help='also write one rosbag2 MCAP per channel under DIR/<channel>')
 
 
-def _key_values(items: list[str], what: str) -> dict:
+def _number(text: str) -> object:
+    """``text`` as YAML reads it, with a number YAML 1.1 leaves a string (``2e-1``) a float."""
+    value = yaml.safe_load(text)
+    if isinstance(value, str):
+        try:
+            return float(value)
+        except ValueError:
+            return value
+    return value
+
+
+def _key_values(items: list[str], what: str, numbers: bool = False) -> dict:
+    """``KEY=VALUE`` items as a dict; ``numbers``: every value a number or a list of them."""
     out = {}
     for item in items:
         key, sep, text = item.partition('=')
         if not sep or not key.strip():
             raise ConfigError(f'{what} needs KEY=VALUE, got {item!r}')
         try:
-            out[key.strip()] = yaml.safe_load(text)
+            value = _number(text)
+            if isinstance(value, list):
+                value = [_number(str(x)) if isinstance(x, str) else x for x in value]
         except yaml.YAMLError:
             raise ConfigError(f'{what} {key}: cannot parse {text!r}') from None
+        values = value if isinstance(value, list) else [value]
+        if numbers and not all(isinstance(x, (int, float)) and not isinstance(x, bool)
+                               and np.isfinite(x) for x in values):
+            raise ConfigError(f'{what} {key.strip()}: {text!r} is not a finite number (or a '
+                              'list of them)')
+        out[key.strip()] = value
     return out
+
+
+#: Most samples ``simulate`` writes: a bound that refuses a typo (``--dt 1e-9``) rather
+#: than being killed by the kernel for memory.
+MAX_SAMPLES = 5 * 10 ** 6
 
 
 def sample_times(duration_s: float, dt_s: float, jitter: float = 0.0,
@@ -90,6 +115,9 @@ def sample_times(duration_s: float, dt_s: float, jitter: float = 0.0,
     if not 0.0 <= jitter < 0.5:
         raise ConfigError(f'--jitter must be in [0, 0.5), got {jitter}')
     n = int(np.floor(duration_s / dt_s + 1e-9)) + 1
+    if n > MAX_SAMPLES:
+        raise ConfigError(f'--duration {duration_s:g} at --dt {dt_s:g} is {n:.3g} samples; at '
+                          f'most {MAX_SAMPLES:.0e} (a longer --dt or a shorter run)')
     t = np.arange(n) * dt_s
     if jitter > 0:
         rng = np.random.default_rng([seed, 1])
@@ -128,11 +156,19 @@ def run(args: argparse.Namespace) -> int:
     params = load_rig_params(args.params) if args.params else RigParams()
     if args.set:
         params = params.with_values(_key_values(args.set, '--set'))
-    kw = _key_values(args.excitation_param, '--excitation-param')
-    t = sample_times(args.duration, args.dt, args.jitter, args.seed)
-    command = make_excitation(args.excitation, t, **kw)
-    result = simulate_rig(params, t, command, seed=args.seed)
+    kw = _key_values(args.excitation_param, '--excitation-param', numbers=True)
     paths = output_paths(args.out, channels)
+    if Path(args.out).is_dir():
+        raise ConfigError(f'--out {args.out} is a folder; --out is a stem (OUT_<channel>.csv, '
+                          f'OUT.json): give e.g. {Path(args.out) / "run"}')
+    taken = [Path(args.bag) / ch for ch in channels if args.bag and (Path(args.bag) / ch).exists()]
+    if taken:                       # refused before any file is written
+        raise ConfigError(f'bag directory {taken[0]} already exists')
+    t = sample_times(args.duration, args.dt, args.jitter, args.seed)
+    command = np.asarray(make_excitation(args.excitation, t, **kw), dtype=float)
+    if not np.all(np.isfinite(command)):
+        raise ConfigError(f'--excitation {args.excitation} with {kw} gives non-finite commands')
+    result = simulate_rig(params, t, command, seed=args.seed)
     units = {'t': 's', 'command': 'mA'}
     for ch in channels:
         _write_csv(paths[ch], ['t', 'command', 'measurement'],

@@ -311,6 +311,10 @@ def test_an_output_never_overwrites_an_input(tmp_path, capsys, command):
             # a --plot that names no figure is taken as a folder, and a file is none
             assert 'which the output would overwrite' in err or (
                 flag == '--plot' and 'is a file, not a folder' in err), err
+    (tmp_path / 'hard.json').hardlink_to(csv)        # another name of the recording's file
+    code = main([command, str(csv), '--quiet', '--workers', '1', '--json',
+                 str(tmp_path / 'hard.json')])
+    assert code == 2 and 'which the output would overwrite' in capsys.readouterr().err
     code = main([command, str(csv), '--quiet', '--json', str(tmp_path / 'a.json'),
                  '--params-out', str(tmp_path / 'a.json')])
     assert code == 2 and 'writes the same file' in capsys.readouterr().err
@@ -396,3 +400,12 @@ def test_whole_record_turns_the_start_state_retry_off_in_identify_and_diagnose(t
         assert make_settings(args).start_state is expected
         args = parser.parse_args(['diagnose', 'run.csv'] + flags)
         assert _settings(args).start_state is expected
+
+
+def test_experiment_out_that_is_a_file_is_refused_before_the_work(tmp_path, capsys):
+    """``experiment --out FILE``: one line, exit 2, before any run (it was an internal error)."""
+    taken = _text(tmp_path / 'taken.csv', 't,command,measurement\n')
+    assert main(['experiment', '--quick', '--out', str(taken)]) == 2
+    err = capsys.readouterr().err
+    assert 'is a file, not a folder' in err and 'internal error' not in err
+    assert taken.read_text() == 't,command,measurement\n'

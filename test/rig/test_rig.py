@@ -458,6 +458,40 @@ def test_cli_simulate_reports_bad_options(tmp_path, capsys):
     assert rc == 2
 
 
+@pytest.mark.parametrize('flags, needle', [
+    (['--excitation-param', 'amplitude_ma=abc'], "amplitude_ma: 'abc' is not a finite number"),
+    (['--excitation-param', 'amplitude_ma=1e400'], 'is not a finite number'),
+    (['--duration', '1', '--dt', '1e-9'], 'at most 5e+06'),               # not killed for memory
+    (['--set', 'integration.max_substep_s=1e-12'], 'integration substeps'),  # not for hours
+])
+def test_cli_simulate_refuses_before_any_work(tmp_path, capsys, flags, needle):
+    """A bad value is one line and exit 2, before a file is written."""
+    rc = cli_main(['simulate', '--duration', '5', *flags, '--out', str(tmp_path / 'x')])
+    err = capsys.readouterr().err
+    assert rc == 2 and needle in err and err.count('\n') == 1, err
+    assert not list(tmp_path.iterdir())
+
+
+def test_cli_simulate_reads_numbers_in_any_spelling_and_refuses_a_folder_stem(tmp_path, capsys):
+    """``2e-1`` is a number (YAML 1.1 left it a string); ``--out DIR`` is no stem."""
+    out = tmp_path / 'run'
+    assert cli_main(['simulate', '--duration', '5', '--dt', '0.1', '--channels', 'position',
+                     '--excitation', 'eq25', '--excitation-param', 'amplitude_ma=2e-1',
+                     '--out', str(out)]) == 0
+    data = np.genfromtxt(tmp_path / 'run_position.csv', delimiter=',', names=True)
+    from hyst_id.signals.excitation import make_excitation
+    np.testing.assert_allclose(data['command'], make_excitation('eq25', data['t'],
+                                                                amplitude_ma=0.2), atol=1e-8)
+    capsys.readouterr()
+    (tmp_path / 'bags' / 'position').mkdir(parents=True)
+    for flags, needle in ((['--out', str(tmp_path)], 'is a folder; --out is a stem'),
+                          (['--out', str(tmp_path / 'again'), '--bag', str(tmp_path / 'bags')],
+                           'already exists')):
+        assert cli_main(['simulate', '--duration', '5', '--channels', 'position', *flags]) == 2
+        assert needle in capsys.readouterr().err
+    assert not list(tmp_path.glob('again*'))         # nothing written before the refusal
+
+
 # ---------------------------------------------------------------- identification
 
 
