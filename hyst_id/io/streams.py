@@ -82,6 +82,23 @@ def gap_note(t_s: np.ndarray, name: str) -> str:
             f't={t_s[k]:.6g} s')
 
 
+def _held_end(cmd_t: np.ndarray, meas_t: np.ndarray, names: tuple[str, str]) -> str:
+    """A note when the command stream ends well before the measurement ('' if not).
+
+    Its last value is then held over the rest: the stream stopped, or it is
+    sent only on change. Noted when the stretch is longer than
+    :data:`GAP_NOTE_FACTOR` of the command's median intervals and than 5 % of the record.
+    """
+    tail_ns = float(meas_t[-1] - cmd_t[-1])
+    whole_ns = float(meas_t[-1] - meas_t[0])
+    median = float(np.median(np.diff(cmd_t))) if cmd_t.size > 1 else 0.0
+    if whole_ns <= 0.0 or tail_ns <= max(GAP_NOTE_FACTOR * median, 0.05 * whole_ns):
+        return ''
+    return (f'{names[0]} ends {tail_ns / 1e9:.3g} s ({100.0 * tail_ns / whole_ns:.0f} % of the '
+            f'record) before {names[1]}: its last value was held over that stretch (a stream '
+            'that stopped, or one sent only on change? trim the record if it stopped)')
+
+
 def pair_streams(cmd_t_ns: np.ndarray, cmd_v: np.ndarray, meas_t_ns: np.ndarray,
                  meas_v: np.ndarray, channel: str, source: str = '',
                  units: tuple[str, str] = ('', ''),
@@ -137,6 +154,9 @@ def pair_streams(cmd_t_ns: np.ndarray, cmd_v: np.ndarray, meas_t_ns: np.ndarray,
     gap = gap_note(t_s, names[1])
     if gap:
         notes.append(gap)
+    held = _held_end(cmd_t, meas_t, names)
+    if held:
+        notes.append(held)
     notes.append(f'time origin t_s = 0: stamp {meas_t[0] / 1e9:.9f} s since the epoch')
     return Recording(t_s=t_s, command=cmd_v[idx], measurement=meas_v, channel=channel,
                      command_unit=units[0], measurement_unit=units[1], source=source,
