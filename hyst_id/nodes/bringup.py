@@ -58,7 +58,7 @@ from rclpy.task import Future
 
 from hyst_id.errors import HystIdError
 from hyst_id.io.recording import CHANNELS
-from hyst_id.io.topics import get_field, parse_field_path, value_field
+from hyst_id.io.topics import parse_field_path, value_field
 from hyst_id.live.buffer import SampleBuffer
 from hyst_id.nodes.actuator_driver import ActuatorDriver
 from hyst_id.nodes.compensator import Compensator
@@ -81,6 +81,7 @@ from hyst_id.nodes.support import (
     stamp_ns,
     stop_signals,
 )
+from hyst_id.nodes.support.field_reads import FieldReads
 
 __all__ = ['Bringup', 'Lockstep', 'PARAMS', 'control_error_percent', 'main']
 
@@ -210,6 +211,7 @@ class Bringup(HystNode):
         self.pipeline.set_parameters([Parameter('step_s', value=self._periods['identify'])])
         self._field = parse_field_path(value_field(self.identifier.p(f'topics.{ch}_type'),
                                                    self.identifier.p(f'topics.{ch}_field')))
+        self._reads = FieldReads(self.get_logger())   # an unreadable one is logged, not kept
         self._buffers = {'uncompensated': SampleBuffer(), 'compensated': SampleBuffer()}
         self._phase = 'start'
         self._phase_t = time.monotonic()
@@ -251,7 +253,9 @@ class Bringup(HystNode):
             return
         t_ns = stamp_ns(msg.header.stamp) if hasattr(msg, 'header') else 0
         t_ns = t_ns or int(info.get('source_timestamp') or 0)
-        buf.add_measurement(t_ns, float(get_field(msg, self._field)))
+        value = self._reads.read('measurement', 'bringup', msg, self._field)
+        if value is not None:
+            buf.add_measurement(t_ns, value)
 
     def _on_reference(self, phase: str, msg: Any, info: dict) -> None:
         if self._phase == phase:

@@ -477,7 +477,7 @@ class Compensator(HystNode):
             ch = self.p('channel')
             inputs.append((self.p(f'topics.{ch}_topic'), self.p(f'topics.{ch}_type')))
         wrong = input_problems(self, inputs, {}, 0.0, math.inf, {})
-        wrong += [w for w in [self.non_finite_problem()] if w]
+        wrong += [w for w in [self.non_finite_problem()] if w] + self._tracking.reads.problems()
         if wrong:
             text = '; '.join(wrong)
             self.get_logger().error(text, throttle_duration_sec=10.0)

@@ -52,7 +52,7 @@ from hyst_id.identification import Identification, IdentifySettings
 from hyst_id.identification.config import make_spec
 from hyst_id.identification.model_choice import AUTO_FAMILIES
 from hyst_id.io.recording import Recording, validate_recording
-from hyst_id.io.topics import get_field, parse_field_path, TopicConfig, value_field
+from hyst_id.io.topics import parse_field_path, TopicConfig, value_field
 from hyst_id.live import (
     diagnosis_statuses,
     DiagnosisJob,
@@ -79,6 +79,7 @@ from hyst_id.nodes.support import (
     spin_node,
     stamp_ns,
 )
+from hyst_id.nodes.support.field_reads import FieldReads
 from hyst_id.nodes.support.identifier_params import (
     default_params_out, identify_settings, PARAMS, validate_identifier_params)
 from hyst_id.nodes.support.result_pub import ResultPublisher
@@ -122,6 +123,7 @@ class Identifier(HystNode):
         self.sliding = SlidingLink(self)
         self._started = time.monotonic()
         self._rx: dict[str, float] = {}     # monotonic time each input was last received
+        self._reads = FieldReads(self.get_logger())
         meas_type = v[f'topics.{self.channel}_type']
         self._cmd_field = parse_field_path(value_field(v['topics.command_type'], v[
             'topics.command_field']))
@@ -195,19 +197,18 @@ class Identifier(HystNode):
 
     def _on_command(self, msg: Any, info: dict) -> None:
         self._rx['command'] = time.monotonic()
-        if self.p('collect') and not self.buffer.add_command(
-                self._stamp(msg, info), float(get_field(msg, self._cmd_field))):
+        if not self.p('collect') or (value := self._reads.read(
+                'command', self.p('topics.command_topic'), msg, self._cmd_field)) is None:
+            return
+        if not self.buffer.add_command(self._stamp(msg, info), value):
             self._non_finite()
 
     def _on_measurement(self, msg: Any, info: dict) -> None:
         self._rx['measurement'] = time.monotonic()
         if not self.p('collect'):
             return
-        try:
-            value = float(get_field(msg, self._meas_field))
-        except (AttributeError, IndexError, KeyError, TypeError, ValueError) as exc:
-            self.get_logger().warning(f'{self._meas_topic}: cannot read the measurement '
-                                      f'field ({exc})', throttle_duration_sec=5.0)
+        if (value := self._reads.read('measurement', self._meas_topic, msg,
+                                      self._meas_field)) is None:
             return
         if not self.buffer.add_measurement(self._stamp(msg, info), value):
             self._non_finite()
@@ -490,7 +491,7 @@ class Identifier(HystNode):
         problems = input_problems(   # a wrong type, or one input arriving without the other
             self, self._expected, self._rx, self._started, self.p('input_timeout_s'),
             {'command': self.p('topics.command_topic'), 'measurement': self._meas_topic})
-        problems += [w for w in [self.non_finite_problem()] if w]
+        problems += [w for w in [self.non_finite_problem()] if w] + self._reads.problems()
         if problems:
             level, msg = 2, '; '.join(problems) + f' ({msg})'
             self.get_logger().error('; '.join(problems), throttle_duration_sec=10.0)

@@ -139,9 +139,8 @@ def test_zero_order_hold_pairing_sort_and_duplicates(tmp_path: Path) -> None:
 
 @pytest.mark.parametrize('stop, noted', [(300, True), (598, False)])
 def test_a_command_stream_that_stops_early_is_noted(tmp_path: Path, stop: int,
-                                                   noted: bool) -> None:
-    """The last command held over the second half is said (it was silent); a last-sample lag
-    is not."""
+                                                    noted: bool) -> None:
+    """The last command held over the second half is said (it was silent); a short lag not."""
     t = np.arange(600) * 0.05
     with BagWriter(tmp_path / 'bag') as bag:
         bag.add_topic('/hyst_id/command', 'std_msgs/msg/Float64')

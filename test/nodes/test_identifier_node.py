@@ -150,6 +150,31 @@ def test_a_refused_run_keeps_its_samples_and_non_finite_ones_are_not_collected(c
     assert ident.buffer.n_measurements == 400               # not cleared: nothing lost
 
 
+def test_messages_whose_field_cannot_be_read_are_an_error_not_a_silent_ok(ctx):
+    """A field that cannot be read: not collected, and the next status an ERROR saying why.
+
+    A JointState with empty ``position``, a command message without the field: the node had
+    stayed OK, collecting 0 samples.
+    """
+    from std_msgs.msg import Float64
+    ident = _make(ctx, Identifier, parameter_overrides=FAST)
+    sent: list[tuple[int, str]] = []
+    ident.publish_diagnostics = lambda level, msg, values=None, **kw: sent.append((level, msg))
+    for _ in range(3):
+        ident._on_measurement(JointState(position=[]), {})   # as the subscription does
+        ident._on_command(JointState(), {})                  # no ``data`` field: no traceback
+        ident._on_command(Float64(data=9.0), {})
+    assert ident.buffer.n_measurements == 0
+    ident._status()
+    assert sent[-1][0] == 2, sent[-1]
+    assert ('3 message(s) not collected: hyst_id/position: cannot read the measurement field'
+            in sent[-1][1]), sent[-1]
+    assert '3 message(s) not collected: hyst_id/command: cannot read the command' in sent[-1][1]
+    ident._on_measurement(JointState(position=[1.0]), {})
+    ident._status()                     # none since: not an error any more
+    assert 'not collected' not in sent[-1][1]
+
+
 def test_a_bad_compensator_node_domains_file_or_mechanism_is_refused_when_set(ctx, tmp_path):
     ident = _make(ctx, Identifier, parameter_overrides=FAST)
     res = ident.set_parameters([Parameter('compensator_node', value='bad name!')])[0]

@@ -33,7 +33,8 @@ from hyst_id.compensation import Compensator as CoreCompensator
 from hyst_id.compensation.tracking import (AdaptiveCompensator, GainOffsetTracker,
                                            SensorPredictor)
 from hyst_id.errors import ConfigError, InvalidParametersError
-from hyst_id.io.topics import get_field, parse_field_path, value_field
+from hyst_id.io.topics import parse_field_path, value_field
+from hyst_id.nodes.support.field_reads import FieldReads
 from hyst_id.nodes.support.params import Param
 from hyst_id.nodes.support.qos import OVERRIDABLE
 from hyst_id.nodes.support.ros import check_field, message_class, stamp_ns
@@ -93,7 +94,9 @@ class TrackingLink:
         self._sub = None
         self._field = None
         self._channel = ''
-        self.bad_samples = 0
+        #: the measurement's field read from each message; unread ones are counted and
+        #: make the compensator's next status an ERROR
+        self.reads = FieldReads(node.get_logger())
         #: time measurements by their header stamps (the compensator runs on stamped
         #: desired values); else by the node's clock, as unstamped desired values are
         self.use_stamps = False
@@ -152,12 +155,8 @@ class TrackingLink:
     def _on_measurement(self, msg: Any) -> None:
         if self.adaptive is None:
             return
-        try:
-            value = float(get_field(msg, self._field))
-        except (AttributeError, IndexError, KeyError, TypeError, ValueError) as exc:
-            self.bad_samples += 1
-            self.node.get_logger().warning(f'tracking: cannot read the measurement ({exc})',
-                                           throttle_duration_sec=5.0)
+        value = self.reads.read('measurement', 'tracking', msg, self._field)
+        if value is None:
             return
         header = getattr(msg, 'header', None)
         ns = stamp_ns(header.stamp) if self.use_stamps and header is not None else 0
@@ -184,4 +183,4 @@ class TrackingLink:
         tr = self.adaptive.tracker
         return {'tracking': tr.state, 'tracking_gain': tr.gain, 'tracking_offset': tr.offset,
                 'tracking_rate_per_s': tr.rate_per_s,
-                'tracking_unreadable_samples': self.bad_samples}
+                'tracking_unreadable_samples': self.reads.count.get('measurement', 0)}
