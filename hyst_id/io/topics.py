@@ -32,9 +32,9 @@ from hyst_id.io.interface_types import STAMPED_VALUE_TYPE
 from hyst_id.io.params_file import read_yaml
 from hyst_id.io.recording import CHANNELS
 
-__all__ = ['NamedIndex', 'NODE_STREAM_KEYS', 'TOPIC_FILE_KEYS', 'TopicConfig', 'get_field',
-           'load_topic_config', 'load_topic_file', 'node_parameters_in', 'parse_field_path',
-           'value_field']
+__all__ = ['NamedIndex', 'NODE_STREAM_KEYS', 'NODE_TOPIC_KEYS', 'TOPIC_FILE_KEYS',
+           'TopicConfig', 'get_field', 'load_topic_config', 'load_topic_file',
+           'node_parameters_in', 'parse_field_path', 'value_field']
 
 #: Per channel: topic, message type, field path, unit.
 _COMMAND_DEFAULTS = ('/hyst_id/command', 'std_msgs/msg/Float64', 'data', 'mA')
@@ -51,6 +51,12 @@ TOPIC_FILE_KEYS = _KEYS
 #: Keys of a ``/**`` topics mapping that only nodes read (``params/stamped.yaml``: the
 #: compensator's desired stream and the excitation's output); recordings ignore them.
 NODE_STREAM_KEYS = frozenset({'desired_type', 'output_type'})
+#: The nodes' own topic names under ``topics:`` (the compensator's desired value, the
+#: excitation's output, the identifier's results): a params file may hold them, a recording's
+#: reader leaves them alone; any other key there is a typo (``test_wiring.py`` checks that
+#: every node's ``topics.*`` parameter is known here).
+NODE_TOPIC_KEYS = frozenset({'desired_topic', 'output_topic', 'identified_params_topic',
+                             'identified_typed_topic'})
 _INDEX = r'\[(\d+|[A-Za-z_][\w.-]*)\]'
 _FIELD_RE = re.compile(rf'[A-Za-z_]\w*({_INDEX})*(\.[A-Za-z_]\w*({_INDEX})*)*')
 
@@ -232,7 +238,7 @@ def node_parameters_in(yaml_path: str | Path) -> list[str]:
 
 
 def _node_parameters(doc: Any) -> list[str]:
-    known = _KEYS | NODE_STREAM_KEYS
+    known = _KEYS | NODE_STREAM_KEYS      # a node's own topics are named as not used here
     keys: set[str] = set()
     for _, _, params in _node_sections(doc if isinstance(doc, dict) else {}):
         if not isinstance(params, dict):
@@ -286,7 +292,7 @@ def _topic_config(doc: Any, yaml_path: Path, channel: str, node: str | None) -> 
     def take(where: str, section: Any, strict: bool) -> None:
         if not isinstance(section, dict):
             raise ConfigError(f'{yaml_path}: {where} must be a mapping')
-        unknown = set(section) - _KEYS - NODE_STREAM_KEYS
+        unknown = set(section) - _KEYS - NODE_STREAM_KEYS - NODE_TOPIC_KEYS
         if strict and unknown:
             raise ConfigError(f'{yaml_path}: unknown key(s) {sorted(unknown)} in '
                               f'{where}; known: {sorted(_KEYS)}')
@@ -304,9 +310,13 @@ def _topic_config(doc: Any, yaml_path: Path, channel: str, node: str | None) -> 
             continue
         if not isinstance(params, dict):
             raise ConfigError(f'{yaml_path}: {where} must be a mapping')
+        # a key of a topics: mapping (or topics.<key>) no node knows is a typo: refused, as in
+        # the top-level layout (a review's topics: position_fild had only been noted)
         if isinstance(params.get('topics'), dict):
-            take(f'{where}.topics', params['topics'], False)
-        take(where, {k.removeprefix('topics.'): v for k, v in params.items()}, False)
+            take(f'{where}.topics', params['topics'], True)
+        take(where, {k.removeprefix('topics.'): v for k, v in params.items()
+                     if k.startswith('topics.')}, True)
+        take(where, {k: v for k, v in params.items() if not k.startswith('topics.')}, False)
     try:
         return TopicConfig.for_channel(channel, merged)
     except ConfigError as exc:

@@ -138,6 +138,21 @@ def test_recovery_does_not_overwrite_a_set_loaded_on_purpose(ctx, tmp_path):
     assert follower.p('c_br') == 0.3
 
 
+def test_every_topic_key_of_a_node_is_known_to_the_recordings_reader():
+    """A ``topics:`` key no node has is refused as a typo by the reader; a node's must pass."""
+    import importlib
+    from hyst_id.io.topics import NODE_STREAM_KEYS, NODE_TOPIC_KEYS
+    known = NODE_STREAM_KEYS | NODE_TOPIC_KEYS
+    for name in ('actuator_driver', 'pipeline_sim', 'excitation', 'identifier', 'compensator',
+                 'recorder', 'replay', 'bringup'):
+        params = importlib.import_module(f'hyst_id.nodes.{name}').PARAMS
+        for p in params:
+            if p.name.startswith('topics.'):
+                key = p.name.removeprefix('topics.')
+                channel_key = key.split('_')[0] in ('command', 'position', 'pressure', 'flow')
+                assert key in known or channel_key or key == 'stamp_source', (name, key)
+
+
 def test_unknown_parameters_are_an_error(ctx, tmp_path):
     assert unknown_overrides(['max_comand', 'topics.flow_topic', 'use_sim_time',
                               'qos_overrides./x.publisher.depth', 'm_l'],
