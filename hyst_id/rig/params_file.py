@@ -40,13 +40,22 @@ from hyst_id.rig.params import (
     RigParams,
 )
 
-__all__ = ['DEFAULT_NODE', 'as_rig_params', 'load_rig_params', 'save_rig_params']
+__all__ = ['DEFAULT_NODE', 'as_rig_params', 'load_rig_params', 'NODE_SCALARS', 'save_rig_params']
 
 #: Node section written by :func:`save_rig_params`.
 DEFAULT_NODE = 'pipeline_sim'
 
 #: Groups of node parameters a ROS params file may hold beside the rig's.
 NODE_GROUPS = ('topics', 'qos_overrides')
+
+#: The pipeline_sim node's own parameters, which its params section may hold beside the rig's
+#: groups (``test_nodes_unit.py`` checks the list against the node's), and ROS's.
+NODE_SCALARS = frozenset({
+    'plant', 'rig_params_file', 'tau_s', 'zeta', 'omega_n', 'pressure_offset_pa',
+    'pressure_gain_pa', 'flow_offset_g_s', 'flow_gain_g_s', 'position_noise_std',
+    'pressure_noise_pa', 'flow_noise_g_s', 'seed', 'publish_position', 'time_scale', 'step_s',
+    'joint_name', 'm_l', 'm_r', 'm_t', 'm_b', 'c_l', 'c_r', 'c_t', 'c_b', 'm_bl', 'c_bl',
+    'c_br', 'use_sim_time'})
 
 
 def load_rig_params(yaml_path: str | Path, *, node: str | None = None) -> RigParams:
@@ -98,7 +107,23 @@ def _from_document(doc: Any, node: str | None = None) -> RigParams:
                  ((k, difflib.get_close_matches(k, RIG_GROUPS, 1)) for k in strays)]
         raise ConfigError(f'unknown parameter group(s) {", ".join(hints)}; rig groups: '
                           f'{", ".join(RIG_GROUPS)}')
+    # the rig's values are all in groups; a scalar beside them is the pipeline_sim node's
+    # parameter or a typo (a review's foo: 1 and group-less actuator keys were ignored)
+    scalars = sorted(str(k) for k, v in merged.items()
+                     if not isinstance(v, Mapping) and k not in NODE_SCALARS)
+    if scalars:
+        raise ConfigError(f'{", ".join(scalars)}: neither rig parameters (a rig file holds them '
+                          'in groups: ' + ', '.join(RIG_GROUPS) + ') nor the pipeline_sim '
+                          "node's" + _group_hints(scalars))
     return rig_params_from_dict(merged, allow_unknown=True)
+
+
+def _group_hints(keys: list[str]) -> str:
+    """'; did you mean actuator.c_t?' for keys that are a field of some rig group."""
+    fields = {f'{g}.{k}' for g, values in rig_params_to_dict(RigParams()).items()
+              for k in values}
+    hints = [m for k in keys for m in sorted(f for f in fields if f.endswith(f'.{k}'))]
+    return f'; did you mean {", ".join(hints[:4])}?' if hints else ''
 
 
 def as_rig_params(params: Any = None) -> RigParams:

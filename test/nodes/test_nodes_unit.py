@@ -100,6 +100,14 @@ def test_every_node_starts_with_defaults(ctx, tmp_path):
     assert comp.step(30.0) == 20.0               # ... within the command limits
 
 
+def test_the_rig_loader_knows_the_pipeline_sim_nodes_parameters():
+    """A rig file's section may hold the node's own scalars; any other scalar is refused."""
+    from hyst_id.nodes.pipeline_sim import PARAMS as SIM_PARAMS
+    from hyst_id.rig.params_file import NODE_SCALARS
+    own = {p.name for p in SIM_PARAMS if '.' not in p.name}
+    assert own <= NODE_SCALARS, sorted(own - NODE_SCALARS)
+
+
 def test_defaults_match_the_params_files():
     """params/<node>.yaml holds exactly the built-in defaults, under /** (any namespace)."""
     import importlib

@@ -355,7 +355,7 @@ def test_plain_nested_and_dotted_layouts(tmp_path):
     dotted = tmp_path / 'dotted.yaml'
     dotted.write_text('/**:\n  ros__parameters:\n    topics: {command_topic: /x}\n'
                       'pipeline_sim:\n  ros__parameters:\n    supply.regulation: false\n'
-                      '    effects.end_stops.enabled: true\n    rate_hz: 20\n')
+                      '    effects.end_stops.enabled: true\n    step_s: 0.05\n')
     want = RigParams().with_values({'supply.regulation': False,
                                     'effects.end_stops.enabled': True})
     assert load_rig_params(plain) == want == load_rig_params(dotted)
@@ -529,3 +529,9 @@ def test_a_misspelled_group_in_a_ros_params_file_is_refused(tmp_path):
     good = tmp_path / 'good.yaml'
     good.write_text('/**:\n  ros__parameters:\n    supply: {regulation: false}\n    plant: rig\n')
     assert load_rig_params(good).supply.regulation is False
+    stray = tmp_path / 'stray.yaml'       # neither the rig's nor the node's: it was ignored
+    stray.write_text('/**:\n  ros__parameters:\n    foo: 1\n    max_substep_s: 0.001\n')
+    with pytest.raises(ConfigError, match=r'foo, max_substep_s: neither rig parameters .* nor '
+                                          r'the pipeline_sim node.s; did you mean '
+                                          r'integration.max_substep_s'):
+        load_rig_params(stray)
