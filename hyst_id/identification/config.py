@@ -77,9 +77,13 @@ def read_domains_file(path: str) -> dict[str, tuple[float, float]]:
     data = data.get('domains', data) if isinstance(data, Mapping) else data
     if not isinstance(data, Mapping):
         raise ConfigError(f'domains file {path} must map parameter names to [low, high]')
+    bad = [str(k) for k, v in data.items() if not (isinstance(v, (list, tuple)) and len(v) == 2)]
+    if bad:          # [0, 1, 2] had been read as [0, 1]
+        raise ConfigError(f'domains file {path}: each entry must be [low, high]; not so: '
+                          f'{", ".join(bad)}')
     try:
         return {str(k): (float(v[0]), float(v[1])) for k, v in data.items()}
-    except (TypeError, ValueError, IndexError):
+    except (TypeError, ValueError):
         raise ConfigError(f'domains file {path}: each entry must be [low, high]') from None
 
 

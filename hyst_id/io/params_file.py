@@ -26,6 +26,21 @@ from hyst_id.errors import ConfigError
 __all__ = ['read_yaml']
 
 
+class _UniqueKeyLoader(yaml.SafeLoader):
+    """PyYAML's safe loader refusing a key given twice in one mapping (it kept the last)."""
+
+    def construct_mapping(self, node: Any, deep: bool = False) -> Any:
+        seen = set()
+        for key_node, _ in node.value:
+            key = self.construct_object(key_node, deep=deep)
+            if isinstance(key, (str, int, float, bool)) and key in seen:
+                raise yaml.constructor.ConstructorError(
+                    None, None, f'the key {key!r} is given twice (the first would be '
+                    'ignored)', key_node.start_mark)
+            seen.add(key)
+        return super().construct_mapping(node, deep=deep)
+
+
 def read_yaml(path: str | Path, what: str = '') -> Any:
     """Parsed YAML document of a file, or a one-line ConfigError.
 
@@ -39,7 +54,7 @@ def read_yaml(path: str | Path, what: str = '') -> Any:
     path = Path(path)
     name = f'{what} {path}' if what else str(path)
     try:
-        return yaml.safe_load(path.read_text(encoding='utf-8'))
+        return yaml.load(path.read_text(encoding='utf-8'), Loader=_UniqueKeyLoader)  # noqa: S506
     except FileNotFoundError:
         raise ConfigError(f'cannot read {name}: no such file') from None
     except OSError as exc:
