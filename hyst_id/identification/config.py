@@ -23,6 +23,7 @@ so that ``hyst-id identify`` and the identifier node build them alike.
 from __future__ import annotations
 
 from collections.abc import Mapping
+import math
 
 from hyst_id.errors import ConfigError
 from hyst_id.identification.chains import chain_spec, ChainSpec
@@ -32,7 +33,14 @@ from hyst_id.io.params_file import read_yaml
 from hyst_id.io.recording import Recording
 from hyst_id.models.registry import DEFAULT_FAMILY, get_family
 
-__all__ = ['check_domains_file', 'make_settings', 'make_spec', 'read_domains_file']
+__all__ = ['check_domains_file', 'make_settings', 'make_spec', 'MAX_POP_SIZE', 'MAX_SEEDS',
+           'read_domains_file']
+
+
+#: Largest GAASS population and number of seeds accepted (the paper's are 10 and 10): a
+#: review's --pop-size 100000000 was killed by the kernel for memory without a word.
+MAX_POP_SIZE = 10_000
+MAX_SEEDS = 10_000
 
 
 def make_settings(*, seeds: int = 10, seed_offset: int = 0, pop_size: int = 10,
@@ -59,8 +67,12 @@ def make_settings(*, seeds: int = 10, seed_offset: int = 0, pop_size: int = 10,
         raise ConfigError(f'the first seed must be >= 0, got {seed_offset}')
     if workers < 0:
         raise ConfigError(f'workers must be >= 0 (0: one per core), got {workers}')
-    if er_bound_percent is not None and not er_bound_percent > 0.0:
-        raise ConfigError(f'the %e_r bound must be > 0 (or none), got {er_bound_percent}')
+    if er_bound_percent is not None and not 0.0 < er_bound_percent < math.inf:
+        raise ConfigError(f'the %e_r bound (--er-bound) must be a finite number > 0 (or none), '
+                          f'got {er_bound_percent}')
+    if pop_size > MAX_POP_SIZE or seeds > MAX_SEEDS:     # refused, not killed for memory
+        raise ConfigError(f'need pop size <= {MAX_POP_SIZE} and seeds <= {MAX_SEEDS}, got '
+                          f'{pop_size} and {seeds}')
     return IdentifySettings(
         pop_size=int(pop_size), maxiter=int(generations), c=float(c), xi=float(xi),
         seeds=tuple(range(int(seed_offset), int(seed_offset) + int(seeds))),
