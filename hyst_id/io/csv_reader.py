@@ -218,6 +218,11 @@ def read_csv(path: str | Path, channel: str, *,
             if col not in names:
                 raise MissingTopicError(f'column {col!r} not in {path}; columns present: '
                                         f'{", ".join(names)}')
+            if names.count(col) > 1:      # the first had been taken without a word
+                at = [i for i, n in enumerate(names) if n == col]
+                raise RecordingError(f'{path}: the header names {len(at)} columns {col!r} '
+                                     f'(indices {at}): rename them, or give the column by '
+                                     'its index')
             index.append(names.index(col))
         else:
             raise ConfigError(f'column {col!r} must be a header name or an integer index')

@@ -185,6 +185,8 @@ CASES = [
     ('domain-given-twice', lambda d: [str(write_csv(d / 'ok15.csv')), '--domains',
                                       str(_text(d / 'dom4.yaml', 'm_l: [0, 1]\nm_l: [0, 2]\n'))],
      "the key 'm_l' is given twice"),
+    ('column-name-twice', lambda d: [str(write_csv(d / 'twice.csv', header='t,command,command'))],
+     "names 2 columns 'command'"),
     ('huge-population', lambda d: [str(write_csv(d / 'ok16.csv')), '--pop-size', '100000000'],
      'pop size <= 10000'),
     ('infinite-er-bound', lambda d: [str(write_csv(d / 'ok17.csv')), '--er-bound', 'inf'],
