@@ -59,6 +59,7 @@ from scipy.optimize import least_squares
 from hyst_id.diagnosis.mechanisms.base import clip_theta, Mechanism
 from hyst_id.diagnosis.model import ComposedModel, solve_linear
 from hyst_id.identification.chains import er_percent
+from hyst_id.identification.refine import residual_scale
 
 __all__ = ['Criteria', 'Data', 'FitResult', 'Comparison', 'evaluate', 'fit_model', 'polish',
            'compare', 'explained_share', 'improvement_z', 'passes_holdout', 'round_record']
@@ -241,9 +242,10 @@ def polish(model: ComposedModel, data: Data, p0: np.ndarray, *, free: np.ndarray
     f0 = obj.sse(q0)
     if free.size == 0 or max_nfev < 2 * (free.size + 1):
         return p0, f0, obj.nfev
+    scale = residual_scale(data.y)      # 1.0 but for a measurement in tiny units
     try:
-        sol = least_squares(obj, q0, bounds=(lo, hi), method='trf', x_scale='jac',
-                            max_nfev=max_nfev)
+        sol = least_squares(obj if scale == 1.0 else (lambda q: obj(q) / scale), q0,
+                            bounds=(lo, hi), method='trf', x_scale='jac', max_nfev=max_nfev)
         q, f = sol.x, obj.sse(sol.x)
     except (ValueError, np.linalg.LinAlgError):
         q, f = q0, f0

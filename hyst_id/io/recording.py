@@ -55,13 +55,6 @@ MAX_ABS_VALUE = 1e15
 #: in a division by zero, 1e-160 in a wrong result); such a span means wrong units.
 MIN_SPAN = 1e-12
 
-#: Below this span the measurement gets a note: scipy's least-squares polish takes its
-#: finite-difference steps relative to max(1, |x|), so slopes far below 1 are stepped by far
-#: more than themselves and fits end in other optima more often (the piezo example, span
-#: 42.7 um, scaled by 10^-k: %e_r 5.652 at k <= 5, 5.675 at k = 6, 5.760 at k = 7, the floor
-#: 5.586; no change up to k = -12).
-SMALL_SPAN = 1e-4
-
 #: A gap longer than this many median sample intervals means the file holds
 #: more than one run (or lost data) and is refused.
 MAX_GAP_FACTOR = 1000.0
@@ -261,13 +254,7 @@ def validate_recording(rec: Recording, *, min_samples: int = MIN_SAMPLES,
             raise RecordingError(f'{name} spans only {span:.3g}, below {MIN_SPAN:.0e}: wrong '
                                  'units? give it in a unit with larger numbers (um rather '
                                  'than m)')
-    span = float(np.ptp(arrays['measurement']))
-    notes = list(rec.notes)
-    if span < SMALL_SPAN and not any('spans only' in str(n) for n in notes):
-        notes.append(f'the measurement spans only {span:.3g}: below {SMALL_SPAN:g} fits end '
-                     'in other optima more often (the polish steps its parameters by at least '
-                     '1e-8); a unit with larger numbers (um rather than m) avoids it')
-    return replace(rec, **arrays, notes=tuple(notes))
+    return replace(rec, **arrays)
 
 
 def validate_part(part: Recording, what: str) -> Recording:

@@ -439,10 +439,10 @@ def test_experiment_out_that_is_a_file_is_refused_before_the_work(tmp_path, caps
 @pytest.mark.parametrize('scale, code, needle', [
     (1e-200, 2, 'measurement spans only'),       # an internal error (division by zero) before
     (1e-160, 2, 'below 1e-12: wrong units?'),     # a wrong result, exit 0, before
-    (1e-7, 0, 'note: the measurement spans only'),
+    (1e-7, 0, 'search domains (auto)'),          # fitted as in its own units
 ])
-def test_a_measurement_in_tiny_units_is_refused_or_noted(tmp_path, capsys, scale, code, needle):
-    """Far below unit scale: refused where the sums of squares underflow, else a note."""
+def test_a_measurement_in_tiny_units_is_refused_or_fitted(tmp_path, capsys, scale, code, needle):
+    """Far below unit scale: refused where the sums of squares underflow, else fitted."""
     csv = write_csv(tmp_path / 'tiny.csv', y=Y * scale)
     got = main(['identify', str(csv), '--quiet', '--seeds', '1',
                 '--generations', '5', '--workers', '1', '--hops', '0', '--global-evals', '0'])

@@ -132,3 +132,24 @@ def test_restarts_stop_when_they_stop_gaining(simulated):
     assert full.nit == 5 * 60          # every restart ran
     assert capped.nit < full.nit       # stopped at the first restart that did not gain
     assert capped.nit % 60 == 0
+
+
+def test_the_fit_does_not_depend_on_the_measurements_units():
+    """The piezo example in um and in units 1e-7 and 1e-12 as large: the same %e_r.
+
+    A review found the polish stopping early in tiny units (least_squares' absolute gtol):
+    5.760 at x 1e-7 and 5.753 at x 1e-12 against 5.652; with the residual scaled by a power of
+    two (``refine.residual_scale``) all three end at 5.6515-5.6516 (differences of 2e-5).
+    """
+    from dataclasses import replace
+    from pathlib import Path
+
+    from hyst_id.identification.refine import residual_scale
+    from hyst_id.io.readers import read_recording
+    path = Path(__file__).resolve().parents[2] / 'docs' / 'examples' / 'piezo_stage.csv'
+    rec = read_recording(path, 'position', columns=['t_s', 'command_V', 'position_um'])
+    assert residual_scale(rec.measurement) == 1.0             # its own units: untouched
+    assert residual_scale(rec.measurement * 1e-7) == 2.0 ** -20   # RMS 1.2e-6 into [1, 2)
+    er = {k: identify(replace(rec, measurement=rec.measurement * 10.0 ** k),
+                      settings=IdentifySettings(workers=1)).er_percent for k in (0, -7, -12)}
+    assert all(abs(e / er[0] - 1.0) < 2e-3 for e in er.values()), er
