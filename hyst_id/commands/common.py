@@ -205,6 +205,23 @@ def _same_file(a: Path, b: Path) -> bool:
         return False
 
 
+def _refuse_links_in_folder(folder: Path, inputs: list[Path]) -> None:
+    """A ConfigError when a file in the ``--plot`` folder is an input under another name.
+
+    The figures are written over the folder's files of their names: one that is a hard or
+    symbolic link to the recording would overwrite it (a review's ``identify_loop.png``).
+    """
+    if not folder.is_dir():
+        return
+    files = [f for f in folder.iterdir() if f.is_file()]
+    for src in inputs:
+        for f in files:
+            if f.resolve() == src.resolve() or _same_file(f, src):
+                raise ConfigError(f'--plot {folder}: {f.name} there is the input {src} under '
+                                  'another name, which a figure would overwrite; give another '
+                                  'folder')
+
+
 def _refuse_overwriting_inputs(args: argparse.Namespace) -> None:
     """A :class:`ConfigError` when an output would overwrite an input or another output.
 
@@ -217,7 +234,10 @@ def _refuse_overwriting_inputs(args: argparse.Namespace) -> None:
     seen: dict[Path, str] = {}
     for opt in _OUTPUTS:
         value = getattr(args, opt, None)
-        if not value or (opt == 'plot' and names_folder(Path(value))):
+        if value and opt == 'plot' and names_folder(Path(value)):
+            _refuse_links_in_folder(Path(value), inputs)
+            continue
+        if not value:
             continue
         flag, out = '--' + opt.replace('_', '-'), Path(value).resolve()
         for src in inputs:

@@ -158,6 +158,12 @@ def run(args: argparse.Namespace) -> int:
         params = params.with_values(_key_values(args.set, '--set'))
     kw = _key_values(args.excitation_param, '--excitation-param', numbers=True)
     paths = output_paths(args.out, channels)
+    if args.params and Path(args.params).is_file():     # OUT.json over a params file named so
+        src = Path(args.params)
+        for out in paths.values():
+            if out.exists() and (out.resolve() == src.resolve() or out.samefile(src)):
+                raise ConfigError(f'--out {args.out} would write {out}, the --params file; '
+                                  'give another stem')
     if Path(args.out).is_dir():
         raise ConfigError(f'--out {args.out} is a folder; --out is a stem (OUT_<channel>.csv, '
                           f'OUT.json): give e.g. {Path(args.out) / "run"}')

@@ -323,6 +323,11 @@ def test_an_output_never_overwrites_an_input(tmp_path, capsys, command):
             # a --plot that names no figure is taken as a folder, and a file is none
             assert 'which the output would overwrite' in err or (
                 flag == '--plot' and 'is a file, not a folder' in err), err
+    (tmp_path / 'figs').mkdir()                       # a figure's name in --plot DIR linked
+    (tmp_path / 'figs' / f'{command}_loop.png').hardlink_to(csv)
+    (tmp_path / 'figs' / 'other.png').symlink_to(csv)
+    code = main([command, str(csv), '--quiet', '--workers', '1', '--plot', str(tmp_path / 'figs')])
+    assert code == 2 and 'is the input' in capsys.readouterr().err
     (tmp_path / 'hard.json').hardlink_to(csv)        # another name of the recording's file
     code = main([command, str(csv), '--quiet', '--workers', '1', '--json',
                  str(tmp_path / 'hard.json')])

@@ -490,6 +490,12 @@ def test_cli_simulate_reads_numbers_in_any_spelling_and_refuses_a_folder_stem(tm
         assert cli_main(['simulate', '--duration', '5', '--channels', 'position', *flags]) == 2
         assert needle in capsys.readouterr().err
     assert not list(tmp_path.glob('again*'))         # nothing written before the refusal
+    params = tmp_path / 'rig.json'                    # YAML reads JSON: a params file so named
+    params.write_text(Path(ROOT / 'params' / 'pipeline.yaml').read_text())
+    before = params.read_text()
+    assert cli_main(['simulate', '--params', str(params), '--duration', '5', '--channels',
+                     'position', '--out', str(tmp_path / 'rig')]) == 2
+    assert 'the --params file' in capsys.readouterr().err and params.read_text() == before
 
 
 # ---------------------------------------------------------------- identification
