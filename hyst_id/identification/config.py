@@ -33,14 +33,19 @@ from hyst_id.io.params_file import read_yaml
 from hyst_id.io.recording import Recording
 from hyst_id.models.registry import DEFAULT_FAMILY, get_family
 
-__all__ = ['check_domains_file', 'make_settings', 'make_spec', 'MAX_POP_SIZE', 'MAX_SEEDS',
-           'read_domains_file']
+__all__ = ['check_domains_file', 'make_settings', 'make_spec', 'MAX_GENERATIONS', 'MAX_HOPS',
+           'MAX_POP_SIZE', 'MAX_SEEDS', 'read_domains_file']
 
 
 #: Largest GAASS population and number of seeds accepted (the paper's are 10 and 10): a
 #: review's --pop-size 100000000 was killed by the kernel for memory without a word.
 MAX_POP_SIZE = 10_000
 MAX_SEEDS = 10_000
+#: Most generations and basin-hopping jumps accepted (the paper's 500 and the default 100):
+#: a review's --generations 10^7 took 2.3 GB up front and 10^8 ended in a MemoryError, and
+#: --hops 2^31 - 1 in one of 176 GiB.
+MAX_GENERATIONS = 1_000_000
+MAX_HOPS = 100_000
 
 
 def make_settings(*, seeds: int = 10, seed_offset: int = 0, pop_size: int = 10,
@@ -70,9 +75,11 @@ def make_settings(*, seeds: int = 10, seed_offset: int = 0, pop_size: int = 10,
     if er_bound_percent is not None and not 0.0 < er_bound_percent < math.inf:
         raise ConfigError(f'the %e_r bound (--er-bound) must be a finite number > 0 (or none), '
                           f'got {er_bound_percent}')
-    if pop_size > MAX_POP_SIZE or seeds > MAX_SEEDS:     # refused, not killed for memory
-        raise ConfigError(f'need pop size <= {MAX_POP_SIZE} and seeds <= {MAX_SEEDS}, got '
-                          f'{pop_size} and {seeds}')
+    if pop_size > MAX_POP_SIZE or seeds > MAX_SEEDS or generations > MAX_GENERATIONS \
+            or hops > MAX_HOPS:                          # refused, not killed for memory
+        raise ConfigError(f'need pop size <= {MAX_POP_SIZE}, seeds <= {MAX_SEEDS}, generations '
+                          f'<= {MAX_GENERATIONS} and hops <= {MAX_HOPS}; got {pop_size}, '
+                          f'{seeds}, {generations} and {hops}')
     return IdentifySettings(
         pop_size=int(pop_size), maxiter=int(generations), c=float(c), xi=float(xi),
         seeds=tuple(range(int(seed_offset), int(seed_offset) + int(seeds))),

@@ -189,6 +189,8 @@ CASES = [
      "names 2 columns 'command'"),
     ('huge-population', lambda d: [str(write_csv(d / 'ok16.csv')), '--pop-size', '100000000'],
      'pop size <= 10000'),
+    ('huge-hops', lambda d: [str(write_csv(d / 'ok19.csv')), '--hops', '2147483647'],
+     'hops <= 100000'),
     ('infinite-er-bound', lambda d: [str(write_csv(d / 'ok17.csv')), '--er-bound', 'inf'],
      'the %e_r bound (--er-bound) must be a finite number'),
     ('negative-global-evals', lambda d: [str(write_csv(d / 'ok6.csv')), '--global-evals',
@@ -454,3 +456,11 @@ def test_a_measurement_in_tiny_units_is_refused_or_fitted(tmp_path, capsys, scal
     err = capsys.readouterr().err
     assert got == code and needle in err, err
     assert 'internal error' not in err and 'Traceback' not in err
+
+
+def test_huge_generations_are_refused_before_any_work(tmp_path, capsys):
+    """--generations 10^8 ended in a MemoryError (exit 3); refused up front, one line."""
+    csv = write_csv(tmp_path / 'run.csv')
+    assert main(['identify', str(csv), '--quiet', '--generations', '100000000']) == 2
+    err = capsys.readouterr().err
+    assert 'generations <= 1000000' in err and 'internal error' not in err

@@ -24,7 +24,8 @@ from rclpy.validate_topic_name import InvalidServiceNameException, validate_topi
 
 from hyst_id.diagnosis.mechanisms.registry import get_mechanisms, mechanism_ids
 from hyst_id.errors import ConfigError
-from hyst_id.identification.config import check_domains_file, make_settings
+from hyst_id.identification.config import (
+    check_domains_file, make_settings, MAX_GENERATIONS, MAX_HOPS, MAX_POP_SIZE, MAX_SEEDS)
 from hyst_id.identification.result import IdentifySettings
 from hyst_id.io.recording import CHANNELS
 from hyst_id.nodes.support.params import field_params, Param, topic_params
@@ -113,11 +114,11 @@ PARAMS = [
           '(0 = only on request)', low=0.0, high=86400.0, unit='s'),
     Param('identify_now', False, 'set true to identify the samples collected so far'),
     Param('clear_after_identify', True, 'start a new run after each identification'),
-    Param('pop_size', 10, 'GAASS population size N_pop', low=2, high=100000),
-    Param('generations', 500, 'GAASS generations', low=1, high=10000000),
+    Param('pop_size', 10, 'GAASS population size N_pop', low=2, high=MAX_POP_SIZE),
+    Param('generations', 500, 'GAASS generations', low=1, high=MAX_GENERATIONS),
     Param('c', 0.007, 'GAASS search-space contraction rate (Eq. 15)', low=1e-9, high=100.0),
     Param('xi', 0.02, 'GAASS mutation subspace coefficient (Eq. 22)', low=1e-9, high=1.0),
-    Param('seeds', 10, 'number of seeds (one GAASS run each)', low=1, high=100000),
+    Param('seeds', 10, 'number of seeds (one GAASS run each)', low=1, high=MAX_SEEDS),
     Param('seed_offset', 0, 'first seed', low=0, high=2**31 - 1),
     Param('workers', 1, '1: seeds one after the other in a worker thread; 0: one worker '
           'process per core; n > 1: n processes', low=0, high=1024),
@@ -130,7 +131,7 @@ PARAMS = [
           'stays above 1.1 x the noise floor (0 = no global phase)', low=0, high=100000000),
     Param('global_runs', 14, 'most runs of the global phase (0 = none)', low=0, high=1000),
     Param('hops', 100, 'when the best seed ends between 1.1 and 4 x the noise floor, the most '
-          'jumps of basin hopping from it (0 = none)', low=0, high=100000),
+          'jumps of basin hopping from it (0 = none)', low=0, high=MAX_HOPS),
     Param('more_starts', False, 'when the chains built from the data stop above the noise '
           'floor, five more ways of sharing the loop width between H and the backlash '
           '(identify --more-starts: finds narrow basins, costs time)'),
@@ -161,12 +162,12 @@ PARAMS = [
           'last identified run)'),
     Param('diagnose_seeds', 2, 'GAASS seeds of the diagnosis baseline fit', low=1, high=1000),
     Param('diagnose_generations', 200, 'GAASS generations of the diagnosis baseline fit',
-          low=1, high=10000000),
+          low=1, high=MAX_GENERATIONS),
     Param('diagnose_train_fraction', 0.7, 'share of the run the diagnosis fits on (the rest is '
           'held out)', low=0.1, high=0.95),
     Param('diagnose_hops', 100, "most jumps of basin hopping in the diagnosis baseline's "
           'identifications (20: about 40 % faster when the chain lacks physics)', low=0,
-          high=100000),
+          high=MAX_HOPS),
     Param('diagnose_more_starts', False, "identify's more_starts in the diagnosis baseline's "
           'identifications (diagnose --more-starts; off: a claim that gains little is '
           'challenged by such a search anyway)'),
