@@ -111,6 +111,15 @@ def _from_document(doc: Any, node: str | None = None) -> RigParams:
     # parameter or a typo (a review's foo: 1 and group-less actuator keys were ignored)
     scalars = sorted(str(k) for k, v in merged.items()
                      if not isinstance(v, Mapping) and k not in NODE_SCALARS)
+    # the simple plant's values that a rig group also has (m_l, tau_s, zeta, ...): a rig
+    # file's actuator.m_l without its group, unless the section says it is the simple plant's
+    if merged.get('plant') != 'simple':
+        shared = sorted(str(k) for k, v in merged.items() if not isinstance(v, Mapping)
+                        and k in NODE_SCALARS and _group_hints([str(k)]))
+        if shared:
+            raise ConfigError(f'{", ".join(shared)}: the pipeline_sim node\'s simple plant reads '
+                              f'{"these" if len(shared) > 1 else "it"} (plant: simple), the rig '
+                              'does not' + _group_hints(shared))
     if scalars:
         raise ConfigError(f'{", ".join(scalars)}: neither rig parameters (a rig file holds them '
                           'in groups: ' + ', '.join(RIG_GROUPS) + ') nor the pipeline_sim '

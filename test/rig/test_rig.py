@@ -541,3 +541,11 @@ def test_a_misspelled_group_in_a_ros_params_file_is_refused(tmp_path):
                                           r'the pipeline_sim node.s; did you mean '
                                           r'integration.max_substep_s'):
         load_rig_params(stray)
+    loose = tmp_path / 'loose.yaml'       # the actuator's m_l without its group: ignored too
+    loose.write_text('/**:\n  ros__parameters:\n    m_l: 1.2\n')
+    with pytest.raises(ConfigError, match=r'm_l: the pipeline_sim node.s simple plant reads it '
+                                          r'\(plant: simple\), the rig does not; did you mean '
+                                          r'actuator.m_l'):
+        load_rig_params(loose)
+    loose.write_text('/**:\n  ros__parameters:\n    plant: simple\n    m_l: 1.2\n')
+    assert load_rig_params(loose) == RigParams()          # said to be the simple plant's
