@@ -92,6 +92,26 @@ def test_the_measurement_topic_reaches_the_tracker(ctx):
     assert spin_nodes_until(ctx[0], [comp, talker], observed, timeout=10.0)
 
 
+def test_unreadable_or_non_finite_measurements_are_an_error_on_diagnostics(ctx):
+    """A NaN reading or an empty JointState while tracking: the next status is an ERROR.
+
+    A review saw the NaN stream leave the status at OK ``compensating`` (only a WARN logged).
+    """
+    comp = _tracking_node(ctx)
+    sent: list[tuple[int, str]] = []
+    comp.publish_diagnostics = lambda level, msg, values=None, **kw: sent.append((level, msg))
+    comp._on_desired(Float64(data=9.0))
+    comp._tracking._on_measurement(_joint(float('nan')))
+    comp._publish_status()
+    assert sent[-1][0] == 2 and 'non-finite' in sent[-1][1], sent[-1]
+    comp._tracking._on_measurement(JointState(position=[]))
+    comp._publish_status()
+    assert sent[-1][0] == 2 and 'not collected: tracking: cannot read' in sent[-1][1], sent[-1]
+    comp._tracking._on_measurement(_joint(8.0))
+    comp._publish_status()
+    assert sent[-1][0] == 0, sent[-1]
+
+
 def test_sensor_parameters_come_with_the_identified_set(ctx):
     comp = _tracking_node(ctx, channel='pressure', **{'tracking.tau_s': 1.0})
     talker = make_node(ctx, Node, 'talker')

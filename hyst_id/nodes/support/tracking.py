@@ -158,6 +158,9 @@ class TrackingLink:
         value = self.reads.read('measurement', 'tracking', msg, self._field)
         if value is None:
             return
+        if not math.isfinite(value):      # counted: the node's next status is an ERROR
+            self.node.note_non_finite('measurement (tracking)')
+            return
         header = getattr(msg, 'header', None)
         ns = stamp_ns(header.stamp) if self.use_stamps and header is not None else 0
         t_s = (ns or self.node.get_clock().now().nanoseconds) * 1e-9
