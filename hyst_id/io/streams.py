@@ -83,20 +83,31 @@ def gap_note(t_s: np.ndarray, name: str) -> str:
 
 
 def _held_end(cmd_t: np.ndarray, meas_t: np.ndarray, names: tuple[str, str]) -> str:
-    """A note when the command stream ends well before the measurement ('' if not).
+    """A note when the command's last value is held over a long stretch ('' if not).
 
-    Its last value is then held over the rest: the stream stopped, or it is
-    sent only on change. Noted when the stretch is longer than
-    :data:`GAP_NOTE_FACTOR` of the command's median intervals and than 5 % of the record.
+    A stretch between two commands, or after the last one, longer than
+    :data:`GAP_NOTE_FACTOR` of the command's median intervals and than 5 % of the record:
+    the stream stopped or has a gap, or it is sent only on change.
     """
-    tail_ns = float(meas_t[-1] - cmd_t[-1])
     whole_ns = float(meas_t[-1] - meas_t[0])
-    median = float(np.median(np.diff(cmd_t))) if cmd_t.size > 1 else 0.0
-    if whole_ns <= 0.0 or tail_ns <= max(GAP_NOTE_FACTOR * median, 0.05 * whole_ns):
+    if whole_ns <= 0.0:
         return ''
-    return (f'{names[0]} ends {tail_ns / 1e9:.3g} s ({100.0 * tail_ns / whole_ns:.0f} % of the '
-            f'record) before {names[1]}: its last value was held over that stretch (a stream '
-            'that stopped, or one sent only on change? trim the record if it stopped)')
+    median = float(np.median(np.diff(cmd_t))) if cmd_t.size > 1 else 0.0
+    limit = max(GAP_NOTE_FACTOR * median, 0.05 * whole_ns)
+    tail_ns = float(meas_t[-1] - cmd_t[-1])
+    if tail_ns > limit:
+        return (f'{names[0]} ends {tail_ns / 1e9:.3g} s ({100.0 * tail_ns / whole_ns:.0f} % of '
+                f'the record) before {names[1]}: its last value was held over that stretch (a '
+                'stream that stopped, or one sent only on change? trim the record if it '
+                'stopped)')
+    inside = cmd_t[(cmd_t >= meas_t[0]) & (cmd_t <= meas_t[-1])]
+    gaps = np.diff(inside) if inside.size > 1 else np.zeros(0)
+    if gaps.size and float(gaps.max()) > limit:
+        k = int(np.argmax(gaps))
+        return (f'{names[0]} has a gap of {gaps[k] / 1e9:.3g} s ({100.0 * gaps[k] / whole_ns:.0f} '
+                f'% of the record) from t = {(inside[k] - meas_t[0]) / 1e9:.6g} s: its value '
+                'was held over it (lost messages, or a stream sent only on change?)')
+    return ''
 
 
 def pair_streams(cmd_t_ns: np.ndarray, cmd_v: np.ndarray, meas_t_ns: np.ndarray,

@@ -137,23 +137,29 @@ def test_zero_order_hold_pairing_sort_and_duplicates(tmp_path: Path) -> None:
     assert 'dropped 3 /hyst_id/position samples before the first command' in notes
 
 
-@pytest.mark.parametrize('stop, noted', [(300, True), (598, False)])
-def test_a_command_stream_that_stops_early_is_noted(tmp_path: Path, stop: int,
-                                                    noted: bool) -> None:
-    """The last command held over the second half is said (it was silent); a short lag not."""
+@pytest.mark.parametrize('stop, gap, noted', [
+    (300, (0, 0), 'ends 15 s (50 % of the record) before /hyst_id/position: its last value '
+                  'was held'),
+    (600, (180, 420), 'has a gap of 12.1 s (40 % of the record) from t = 8.95 s'),
+    (598, (0, 0), ''), (600, (100, 110), '')])
+def test_a_command_stream_that_stops_early_is_noted(tmp_path: Path, stop: int, gap: tuple,
+                                                    noted: str) -> None:
+    """The last command held over a gap or the end is said (it was silent); a short one not."""
     t = np.arange(600) * 0.05
     with BagWriter(tmp_path / 'bag') as bag:
         bag.add_topic('/hyst_id/command', 'std_msgs/msg/Float64')
         bag.add_topic('/hyst_id/position', 'sensor_msgs/msg/JointState')
         for k in range(600):
             stamp = T0 + int(round(t[k] * 1e9))
-            if k < stop:
+            if k < stop and not gap[0] <= k < gap[1]:
                 bag.write('/hyst_id/command', stamp, {'data': 9 + np.sin(t[k])})
             bag.write('/hyst_id/position', stamp + 1000, {
                 'header': {'stamp': stamp + 1000}, 'position': [float(np.cos(t[k]))]})
     notes = ' | '.join(read_recording(tmp_path / 'bag', 'position').notes)
-    assert ('/hyst_id/command ends 15 s (50 % of the record) before /hyst_id/position: its '
-            'last value was held' in notes) is noted, notes
+    if noted:
+        assert noted in notes, notes
+    else:
+        assert 'held' not in notes, notes
 
 
 def test_iter_bag_messages_order_and_filter(tmp_path: Path) -> None:
