@@ -41,10 +41,13 @@ from typing import Any, Callable, Iterable
 
 from hyst_id.errors import ConfigError, HystIdError, TruncatedBagError
 from hyst_id.identification.workers import map_in_processes, n_processes
+from hyst_id.io.csv_reader import CSV_SUFFIXES
 
 __all__ = ['FleetOptions', 'find_recordings', 'fleet_task', 'result_path', 'run_fleet']
 
 _RECORDING_SUFFIXES = ('.mcap', '.csv', '.tsv')
+#: Suffixes of a file named on the command line: every one ``identify`` reads.
+_NAMED_SUFFIXES = ('.mcap', *CSV_SUFFIXES)
 
 
 @dataclass(frozen=True)
@@ -84,14 +87,19 @@ def find_recordings(inputs: Iterable[str]) -> list[Path]:
         if not matches:
             raise ConfigError(f'{item}: no such file, directory or glob match')
         for path in matches:
-            for rec in _walk(path):
+            for rec in _walk(path, named=True):
                 found[str(rec.resolve())] = rec
     return [found[k] for k in sorted(found)]
 
 
-def _walk(path: Path) -> Iterable[Path]:
+def _walk(path: Path, named: bool = False) -> Iterable[Path]:
+    """Recordings at ``path``; a file named by the user (or its glob) may also be ``.txt``.
+
+    A ``.txt`` file met while searching a directory is left out (notes and readmes sit
+    beside recordings); named, it is read as ``identify`` reads it.
+    """
     if path.is_file():
-        if path.suffix.lower() in _RECORDING_SUFFIXES:
+        if path.suffix.lower() in (_NAMED_SUFFIXES if named else _RECORDING_SUFFIXES):
             yield path
         return
     if (path / 'metadata.yaml').exists():

@@ -79,6 +79,12 @@ def test_find_recordings(fleet_dir):
     assert find_recordings([str(fleet_dir / 'valve_*' / 'week0')]) == [
         fleet_dir / 'valve_a' / 'week0', fleet_dir / 'valve_b' / 'week0']
 
+    notes = fleet_dir / 'notes.txt'        # a .txt beside recordings is not one; named, it is
+    notes.write_text('t,command,measurement\n')
+    assert notes not in find_recordings([str(fleet_dir)])
+    assert find_recordings([str(notes)]) == [notes]
+    notes.unlink()
+
 
 def test_fleet_rows_errors_resume_and_trends(fleet_dir, tmp_path):
     recs = find_recordings([str(fleet_dir)])
