@@ -444,7 +444,7 @@ class Compensator(HystNode):
             full = doc.get('params') if isinstance(doc.get('params'), dict) else {}
             values.update({f'tracking.{k}': float(full[k]) for k in SENSOR_NAMES if k in full})
         except (ValueError, TypeError, KeyError, AttributeError) as exc:
-            log.warning(f'ignored identified parameters: not the expected JSON ({exc})')
+            self.note_refused('identified parameters', f'not the expected JSON ({exc})')
             return
         if channel != self.p('channel'):
             log.info(f'ignored identified parameters of channel {channel!r} (this compensator '
@@ -459,7 +459,7 @@ class Compensator(HystNode):
             + [Parameter('er_percent', value=er)])
         self._source_hint = ''
         if not result.successful:
-            log.warning(f'identified parameters rejected: {result.reason}')
+            self.note_refused('identified parameters', result.reason, counted=False)
 
     def _publish_status(self) -> None:
         model = self._comp.model
@@ -494,6 +494,8 @@ class Compensator(HystNode):
         elif model is None:
             self.publish_diagnostics(1, 'no valid parameter set: passing the desired value '
                                      'through unchanged', values)
+        elif self.refused_note:             # the last set from the topic: the one before stays
+            self.publish_diagnostics(1, self.refused_note + '; the set before it stays', values)
         else:
             self.publish_diagnostics(0, f'compensating ({self.p("channel")})', values)
 

@@ -129,3 +129,27 @@ def test_tracking_without_its_sensor_parameters_is_refused(ctx):
     result = comp.set_parameters_atomically([Parameter('channel', value='flow'),
                                              Parameter('tracking.enabled', value=True)])
     assert not result.successful and 'tracking.zeta' in result.reason
+
+
+def test_a_refused_identified_set_is_a_warning_on_diagnostics_until_one_is_accepted(ctx):
+    """Not JSON, an incomplete set, an invalid loop: counted, a WARN with the reason.
+
+    The set before stays. A review saw OK throughout and only the invalid loop counted.
+    """
+    comp = make_node(ctx, Compensator, parameter_overrides=[
+        Parameter(k, value=v) for k, v in PAPER.items()])
+    sent: list[tuple[int, str]] = []
+    comp.publish_diagnostics = lambda level, msg, values=None, **kw: sent.append((level, msg))
+    bad = ['{not json', json.dumps({'channel': 'position', 'params': {'m_l': 1.0}}),
+           json.dumps({'channel': 'position', 'params': {**PAPER, 'm_t': -3.0}})]
+    for k, text in enumerate(bad, start=1):
+        comp._on_identified(String(data=text))
+        assert comp.rejected_updates == k
+        comp._publish_status()
+        assert sent[-1][0] == 1 and 'identified parameters refused' in sent[-1][1], sent[-1]
+        assert 'the set before it stays' in sent[-1][1]
+    assert comp.p('m_l') == PAPER['m_l'] and comp.model is not None
+    comp._on_identified(String(data=json.dumps({'channel': 'position',
+                                                'params': {**PAPER, 'm_l': 1.02}})))
+    comp._publish_status()
+    assert sent[-1][0] == 0 and comp.p('m_l') == 1.02, sent[-1]

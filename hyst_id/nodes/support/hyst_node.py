@@ -122,6 +122,9 @@ class HystNode(Node):
         self.non_finite_seen, self._non_finite_new = 0, False
         #: Parameter changes rejected since the start.
         self.rejected_updates = 0
+        #: Words for the last input refused (a parameter set from a topic); '' once a
+        #: parameter change is accepted.
+        self.refused_note = ''
         defaults = dict(defaults or {})
         unknown = set(defaults) - set(self._param_table)
         if unknown:
@@ -243,6 +246,7 @@ class HystNode(Node):
             self.get_logger().warning(f'rejected parameter change '
                                       f'{", ".join(sorted(changed))}: {reason}')
             return SetParametersResult(successful=False, reason=reason)
+        self.refused_note = ''          # a change accepted since: the refusal is history
         self.apply_params(values, changed)
         return SetParametersResult(successful=True)
 
@@ -276,6 +280,15 @@ class HystNode(Node):
         self._non_finite_new = True
         self.get_logger().warning(f'ignored a non-finite {what} ({self.non_finite_seen} so '
                                   'far)', throttle_duration_sec=5.0)
+
+    def note_refused(self, what: str, reason: str, counted: bool = True) -> None:
+        """An input refused (a set from a topic): logged, kept for the status, counted.
+
+        ``counted=False`` where the parameter callback has counted it already.
+        """
+        self.rejected_updates += int(counted)
+        self.refused_note = f'{what} refused: {reason}'
+        self.get_logger().warning(self.refused_note)
 
     def non_finite_problem(self) -> str:
         """Words for non-finite inputs since the last call ('' when none came)."""
