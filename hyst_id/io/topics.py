@@ -312,6 +312,12 @@ def _topic_config(doc: Any, yaml_path: Path, channel: str, node: str | None) -> 
             raise ConfigError(f'{yaml_path}: {where} must be a mapping')
         # a key of a topics: mapping (or topics.<key>) no node knows is a typo: refused, as in
         # the top-level layout (a review's topics: position_fild had only been noted)
+        dotted = {k.removeprefix('topics.') for k in params if str(k).startswith('topics.')}
+        both = sorted(dotted & set(params['topics'])) if isinstance(params.get('topics'),
+                                                                    dict) else []
+        if both:        # which one a node reads depends on their order
+            raise ConfigError(f'{yaml_path}: {where} gives {", ".join(both)} twice, as '
+                              'topics.<key> and under topics:; keep one')
         if isinstance(params.get('topics'), dict):
             take(f'{where}.topics', params['topics'], True)
         take(where, {k.removeprefix('topics.'): v for k, v in params.items()
