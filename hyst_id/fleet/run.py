@@ -43,7 +43,8 @@ from hyst_id.errors import ConfigError, HystIdError, TruncatedBagError
 from hyst_id.identification.workers import map_in_processes, n_processes
 from hyst_id.io.csv_reader import CSV_SUFFIXES
 
-__all__ = ['FleetOptions', 'find_recordings', 'fleet_task', 'result_path', 'run_fleet']
+__all__ = ['file_stamp', 'FleetOptions', 'find_recordings', 'fleet_task', 'result_path',
+           'run_fleet']
 
 _RECORDING_SUFFIXES = ('.mcap', '.csv', '.tsv')
 #: Suffixes of a file named on the command line: every one ``identify`` reads.
@@ -116,6 +117,22 @@ def result_path(out_dir: Path, recording: Path) -> Path:
     return Path(out_dir) / 'recordings' / f'{Path(recording).name}-{digest}.json'
 
 
+def _options_doc(options: FleetOptions) -> dict:
+    """The options as a result's JSON holds them (lists for tuples)."""
+    return json.loads(json.dumps({**asdict(options), 'topics': str(options.topics or '')}))
+
+
+def file_stamp(path: Path) -> list:
+    """Size and modification time of a recording (a bag folder: of all its files).
+
+    A resumed fleet keeps an earlier result only for the same stamp and options; a
+    review's recording replaced by a shorter one had kept its old row.
+    """
+    files = sorted(p for p in path.rglob('*') if p.is_file()) if path.is_dir() else [path]
+    stats = [f.stat() for f in files if f.exists()]
+    return [sum(st.st_size for st in stats), max((st.st_mtime_ns for st in stats), default=0)]
+
+
 def fleet_task(path: str, options: FleetOptions) -> dict:
     """Identify (and diagnose) one recording; a document, never an exception.
 
@@ -123,8 +140,8 @@ def fleet_task(path: str, options: FleetOptions) -> dict:
     bad recording gives).
     """
     t0 = time.monotonic()
-    doc: dict[str, Any] = {'recording': path,
-                           'options': {**asdict(options), 'topics': str(options.topics or '')}}
+    doc: dict[str, Any] = {'recording': path, 'options': _options_doc(options),
+                           'file': file_stamp(Path(path))}
     try:
         from hyst_id.identification import identify
         from hyst_id.identification.config import make_settings, make_spec
@@ -185,18 +202,21 @@ def run_fleet(recordings: list[Path], out_dir: str | Path, options: FleetOptions
               progress: Callable[[int, int, dict], None] | None = None) -> list[dict]:
     """Run :func:`fleet_task` over ``recordings``; return every document (old and new).
 
-    A recording whose JSON in ``out_dir/recordings`` already says ``ok`` is
-    not run again (resume; its document gets ``resumed: true``); failed
-    ones are retried. Each document is written as soon as it arrives, so an
-    interrupted fleet loses only the running tasks.
+    A recording whose JSON in ``out_dir/recordings`` already says ``ok``, for
+    the same options and the same file (:func:`file_stamp`), is not run again
+    (resume; its document gets ``resumed: true``); failed or changed ones are run
+    again. Each document is written as soon as it arrives, so an interrupted fleet
+    loses only the running tasks.
     """
     out_dir = Path(out_dir)
     (out_dir / 'recordings').mkdir(parents=True, exist_ok=True)
     docs: dict[str, dict] = {}
     todo = []
+    current = _options_doc(options)
     for rec in recordings:
         old = _read(result_path(out_dir, rec))
-        if old is not None and old.get('status') == 'ok':
+        if old is not None and old.get('status') == 'ok' and old.get('options') == current \
+                and old.get('file') == file_stamp(rec):
             docs[str(rec)] = {**old, 'resumed': True}
         else:
             todo.append(rec)

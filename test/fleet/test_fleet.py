@@ -23,7 +23,9 @@ without excitation are in the same fleet.
 
 from __future__ import annotations
 
+import dataclasses
 import json
+import os
 import signal
 import subprocess
 import sys
@@ -112,6 +114,19 @@ def test_fleet_rows_errors_resume_and_trends(fleet_dir, tmp_path):
     again = run_fleet(recs, tmp_path, FAST, workers=2,
                       progress=lambda k, n, d: seen.append(d['recording']))
     assert len(seen) == 3 and sum(bool(d.get('resumed')) for d in again) == 7
+    # a recording changed since, or other options: run again (a stale row had been kept)
+    good = next(r for r in recs if r.name not in set(bad))
+    for f in [good] if good.is_file() else list(good.iterdir()):
+        os.utime(f, ns=(f.stat().st_atime_ns, f.stat().st_mtime_ns + 10**9))
+    seen.clear()
+    run_fleet(recs, tmp_path, FAST, workers=2,
+              progress=lambda k, n, d: seen.append(d['recording']))
+    assert str(good) in seen and len(seen) == 4, seen
+    seen.clear()
+    other = dataclasses.replace(FAST, generations=FAST.generations + 1)
+    run_fleet(recs, tmp_path, other, workers=2,
+              progress=lambda k, n, d: seen.append(d['recording']))
+    assert len(seen) == 10
 
 
 def test_cli_fleet_writes_table_and_trends(fleet_dir, tmp_path, capsys):
