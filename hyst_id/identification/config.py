@@ -94,6 +94,9 @@ def read_domains_file(path: str) -> dict[str, tuple[float, float]]:
     """Search domains from a YAML file: ``name: [low, high]`` (optionally under ``domains:``)."""
     data = read_yaml(path, 'domains file') or {}
     data = data.get('domains', data) if isinstance(data, Mapping) else data
+    if isinstance(data, Mapping) and not data:     # it had been taken as auto without a word
+        raise ConfigError(f'domains file {path} names no parameter (for domains from the '
+                          "data give 'auto')")
     if not isinstance(data, Mapping):
         raise ConfigError(f'domains file {path} must map parameter names to [low, high]')
     bad = [str(k) for k, v in data.items() if not (isinstance(v, (list, tuple)) and len(v) == 2)]

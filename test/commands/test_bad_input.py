@@ -182,6 +182,8 @@ CASES = [
     ('domain-of-three-numbers', lambda d: [str(write_csv(d / 'ok14.csv')), '--domains',
                                            str(_text(d / 'dom3.yaml', 'm_l: [0, 1, 2]\n'))],
      'each entry must be [low, high]; not so: m_l'),
+    ('domains-file-empty', lambda d: [str(write_csv(d / 'ok20.csv')), '--domains',
+                                      str(_text(d / 'dom5.yaml', ''))], 'names no parameter'),
     ('domain-given-twice', lambda d: [str(write_csv(d / 'ok15.csv')), '--domains',
                                       str(_text(d / 'dom4.yaml', 'm_l: [0, 1]\nm_l: [0, 2]\n'))],
      "the key 'm_l' is given twice"),
