@@ -24,7 +24,7 @@ from typing import Any
 from hyst_id.errors import ConfigError, TruncatedBagError
 from hyst_id.identification import config, IdentifySettings
 from hyst_id.identification.chains import CHAIN_NAMES, ChainSpec
-from hyst_id.io.outputs import make_output_folder, names_folder
+from hyst_id.io.outputs import make_output_folder, names_folder, same_file
 from hyst_id.io.recording import gap_note, Recording
 
 __all__ = ['add_output_arguments', 'add_recording_arguments', 'add_settings_arguments',
@@ -197,14 +197,6 @@ _INPUTS = ('recording', 'params', 'sim', 'domains')
 _OUTPUTS = ('json', 'params_out', 'sim_out', 'plot')
 
 
-def _same_file(a: Path, b: Path) -> bool:
-    """Whether ``a`` and ``b`` are one file (a hard link is another name for it)."""
-    try:
-        return a.is_file() and b.is_file() and a.samefile(b)
-    except OSError:
-        return False
-
-
 def _refuse_links_in_folder(folder: Path, inputs: list[Path]) -> None:
     """A ConfigError when a file in the ``--plot`` folder is an input under another name.
 
@@ -216,7 +208,7 @@ def _refuse_links_in_folder(folder: Path, inputs: list[Path]) -> None:
     files = [f for f in folder.iterdir() if f.is_file()]
     for src in inputs:
         for f in files:
-            if f.resolve() == src.resolve() or _same_file(f, src):
+            if same_file(f, src):
                 raise ConfigError(f'--plot {folder}: {f.name} there is the input {src} under '
                                   'another name, which a figure would overwrite; give another '
                                   'folder')
@@ -234,15 +226,15 @@ def _refuse_overwriting_inputs(args: argparse.Namespace) -> None:
     seen: dict[Path, str] = {}
     for opt in _OUTPUTS:
         value = getattr(args, opt, None)
-        if value and opt == 'plot' and names_folder(Path(value)):
-            _refuse_links_in_folder(Path(value), inputs)
-            continue
         if not value:
+            continue
+        if opt == 'plot' and names_folder(Path(value)):
+            _refuse_links_in_folder(Path(value), inputs)
             continue
         flag, out = '--' + opt.replace('_', '-'), Path(value).resolve()
         for src in inputs:
             here = src.resolve()
-            if out == here or _same_file(out, here) or (
+            if out == here or same_file(out, here) or (
                     here.is_dir() and out.is_file() and here in out.parents):
                 what = f'the input {src}' if out == here else f'a file of the input {src}'
                 raise ConfigError(f'{flag} {value}: that is {what}, which the output would '

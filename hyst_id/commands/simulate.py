@@ -31,6 +31,7 @@ import numpy as np
 import yaml
 
 from hyst_id.errors import ConfigError
+from hyst_id.io.outputs import same_file
 from hyst_id.io.recording import CHANNELS
 from hyst_id.signals.excitation import EXCITATIONS, make_excitation
 
@@ -65,9 +66,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help='also write one rosbag2 MCAP per channel under DIR/<channel>')
 
 
-def _number(text: str) -> object:
-    """``text`` as YAML reads it, with a number YAML 1.1 leaves a string (``2e-1``) a float."""
-    value = yaml.safe_load(text)
+def _number(value: object) -> object:
+    """A string that is a number YAML 1.1 leaves a string (``2e-1``) as a float."""
     if isinstance(value, str):
         try:
             return float(value)
@@ -84,9 +84,8 @@ def _key_values(items: list[str], what: str, numbers: bool = False) -> dict:
         if not sep or not key.strip():
             raise ConfigError(f'{what} needs KEY=VALUE, got {item!r}')
         try:
-            value = _number(text)
-            if isinstance(value, list):
-                value = [_number(str(x)) if isinstance(x, str) else x for x in value]
+            value = yaml.safe_load(text)
+            value = [_number(x) for x in value] if isinstance(value, list) else _number(value)
         except yaml.YAMLError:
             raise ConfigError(f'{what} {key}: cannot parse {text!r}') from None
         values = value if isinstance(value, list) else [value]
@@ -161,7 +160,7 @@ def run(args: argparse.Namespace) -> int:
     if args.params and Path(args.params).is_file():     # OUT.json over a params file named so
         src = Path(args.params)
         for out in paths.values():
-            if out.exists() and (out.resolve() == src.resolve() or out.samefile(src)):
+            if same_file(out, src):
                 raise ConfigError(f'--out {args.out} would write {out}, the --params file; '
                                   'give another stem')
     if Path(args.out).is_dir():

@@ -20,10 +20,18 @@ from pathlib import Path
 
 from hyst_id.errors import ConfigError
 
-__all__ = ['IMAGE_SUFFIXES', 'make_output_folder', 'names_folder']
+__all__ = ['IMAGE_SUFFIXES', 'make_output_folder', 'names_folder', 'same_file']
 
 #: Suffixes of a figure file (what matplotlib writes); another suffix is a folder's name.
 IMAGE_SUFFIXES = frozenset({'.png', '.svg', '.pdf', '.jpg', '.jpeg', '.eps'})
+
+
+def same_file(a: Path, b: Path) -> bool:
+    """Whether ``a`` and ``b`` are one file (a hard or symbolic link is another name for it)."""
+    try:
+        return a.is_file() and b.is_file() and a.samefile(b)
+    except OSError:
+        return False
 
 
 def names_folder(path: str | Path) -> bool:

@@ -82,7 +82,7 @@ def gap_note(t_s: np.ndarray, name: str) -> str:
             f't={t_s[k]:.6g} s')
 
 
-def _held_end(cmd_t: np.ndarray, meas_t: np.ndarray, names: tuple[str, str]) -> str:
+def _held_command(cmd_t: np.ndarray, meas_t: np.ndarray, names: tuple[str, str]) -> str:
     """A note when the command's last value is held over a long stretch ('' if not).
 
     A stretch between two commands, or after the last one, longer than
@@ -165,7 +165,7 @@ def pair_streams(cmd_t_ns: np.ndarray, cmd_v: np.ndarray, meas_t_ns: np.ndarray,
     gap = gap_note(t_s, names[1])
     if gap:
         notes.append(gap)
-    held = _held_end(cmd_t, meas_t, names)
+    held = _held_command(cmd_t, meas_t, names)
     if held:
         notes.append(held)
     notes.append(f'time origin t_s = 0: stamp {meas_t[0] / 1e9:.9f} s since the epoch')

@@ -24,6 +24,7 @@ path or nothing).
 from __future__ import annotations
 
 import difflib
+import functools
 from pathlib import Path
 from typing import Any, Mapping
 
@@ -127,11 +128,16 @@ def _from_document(doc: Any, node: str | None = None) -> RigParams:
     return rig_params_from_dict(merged, allow_unknown=True)
 
 
+@functools.cache
+def _rig_fields() -> frozenset[str]:
+    """Every rig value as ``group.name``."""
+    return frozenset(f'{g}.{k}' for g, values in rig_params_to_dict(RigParams()).items()
+                     for k in values)
+
+
 def _group_hints(keys: list[str]) -> str:
     """'; did you mean actuator.c_t?' for keys that are a field of some rig group."""
-    fields = {f'{g}.{k}' for g, values in rig_params_to_dict(RigParams()).items()
-              for k in values}
-    hints = [m for k in keys for m in sorted(f for f in fields if f.endswith(f'.{k}'))]
+    hints = [m for k in keys for m in sorted(f for f in _rig_fields() if f.endswith(f'.{k}'))]
     return f'; did you mean {", ".join(hints[:4])}?' if hints else ''
 
 
