@@ -45,8 +45,9 @@ __all__ = ['refine', 'residual_scale', 'SMALL_RMS']
 #: two that brings the RMS into [1, 2) (exact: the same fit in other units). least_squares
 #: stops where its scaled gradient falls below an absolute ``gtol`` (1e-8), which the
 #: residuals of a measurement in tiny units reach at once: a review's piezo example in metres
-#: (x 1e-6, x 1e-7) ended at %e_r 5.675 and 5.760 against 5.652, and at 5.652 with it. Above
-#: it nothing changes (the documented families' measurements have RMS 0.04 and more).
+#: (x 1e-6, x 1e-7) ended at %e_r 5.675 and 5.760 against 5.652, and at 5.652 with it
+#: (``bench/unit_scales.py``). Above it nothing changes (the documented families'
+#: measurements have RMS 0.04 and more).
 SMALL_RMS = 1e-2
 
 
