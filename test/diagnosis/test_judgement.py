@@ -109,6 +109,28 @@ def test_a_tied_fit_against_its_own_physics_steps_back_and_the_report_says_why()
     assert choose([decay, grow], data, crit)[0] is decay
 
 
+def test_judge_asks_the_block_for_its_doubt_on_the_training_readings():
+    """The doubt reaches the comparison (the tie rule reads it there), from the fit's values."""
+    from test_blocked_cv import _record
+
+    from hyst_id.diagnosis.result import DiagnoseSettings
+    from hyst_id.diagnosis.trial import judge
+    data, plain, delayed = _record()
+    asked = []
+
+    def doubt(theta, coef, labels, readings):
+        asked.append((theta, readings))
+        return 'against its physics'
+
+    block = SimpleNamespace(id='dead_time', evidence=lambda loc: (0.0, {}),
+                            implausible=lambda *a, **k: '', doubt=doubt)
+    comp = judge(block, plain, delayed, data, None, DiagnoseSettings(), None)
+    assert comp.doubt == 'against its physics'
+    (theta, readings), = asked
+    assert theta.tolist() == [0.2]
+    np.testing.assert_array_equal(readings, data.y[:data.n_train])
+
+
 def test_supply_decay_doubts_a_fit_whose_readings_rise():
     """The reading the decaying gain leaves unchanged above most readings: they would rise."""
     from hyst_id.diagnosis.mechanisms.supply_decay import MECHANISM as decay
