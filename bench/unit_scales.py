@@ -12,7 +12,7 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
-"""The piezo example identified with its measurement in other units: the same fit?
+"""The piezo example identified with its measurement in other units: whether the fit is the same.
 
 ``docs/examples/piezo_stage.csv`` (volts -> um) with the measurement multiplied by
 10^k for each ``k`` given, identified with the default settings (two worker processes);
