@@ -83,6 +83,10 @@ class DiagnoseSettings:
         command's first reversal on, and diagnose that instead when a probe
         there nears the floor (:mod:`hyst_id.diagnosis.start_cut`: an actuator
         that starts inside its play). On by default.
+    joint_generations : int
+        Generations of the joint search of a candidate with the chain over the
+        whole box (:mod:`hyst_id.diagnosis.joint`), run where a candidate's
+        local fit lowers the training BIC yet stays above the floor; 0: none.
     should_stop : callable, optional
         Passed to the baseline's identifications (``identify(should_stop=...)``:
         looked at before each jump of hopping and each generation of an
@@ -103,6 +107,7 @@ class DiagnoseSettings:
     hops: int = 100
     more_starts: bool = False
     start_state: bool = True
+    joint_generations: int = 300
     should_stop: Callable[[], bool] | None = field(default=None, compare=False, repr=False)
 
 

@@ -52,6 +52,7 @@ error are reported with the finding as a judgement call.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Callable
 
 import numpy as np
 from scipy.optimize import least_squares
@@ -62,7 +63,8 @@ from hyst_id.identification.chains import er_percent
 from hyst_id.identification.refine import residual_scale
 
 __all__ = ['Criteria', 'Data', 'FitResult', 'Comparison', 'evaluate', 'fit_model', 'polish',
-           'compare', 'explained_share', 'improvement_z', 'passes_holdout', 'round_record']
+           'compare', 'explained_share', 'improvement_z', 'passes_holdout', 'round_record',
+           'training_sse']
 
 
 @dataclass(frozen=True)
@@ -224,6 +226,16 @@ class _Objective:
     def sse(self, q: np.ndarray) -> float:
         r = self(q)
         return float(r @ r)
+
+
+def training_sse(model: ComposedModel, data: Data, p_base: np.ndarray
+                 ) -> Callable[[np.ndarray], float]:
+    """The training part's sum of squared residuals as a function of all of ``model``'s values.
+
+    The linear part is solved at each point; an infeasible point costs the
+    residual of a prediction ten times the measurement's RMS off.
+    """
+    return _Objective(model, data, p_base, np.arange(model.n_params)).sse
 
 
 def polish(model: ComposedModel, data: Data, p0: np.ndarray, *, free: np.ndarray | None = None,

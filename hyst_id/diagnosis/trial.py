@@ -33,6 +33,7 @@ from typing import Callable
 import numpy as np
 
 from hyst_id.diagnosis.baseline import quick_memo, quick_starts, remember
+from hyst_id.diagnosis.joint import JOINT_LEADERS, joint_search, worth_searching
 from hyst_id.diagnosis.locate import Localization
 from hyst_id.diagnosis.mechanisms.base import Context, Mechanism
 from hyst_id.diagnosis.model import ComposedModel, held
@@ -81,6 +82,7 @@ def try_all(mechs: list[Mechanism], current: FitResult, data: Data, ctx: Context
     own = [i for i in range(len(mechs)) if i not in twin]
     got = dict(zip(own, _fit_and_judge([mechs[i] for i in own], current, data, ctx, settings,
                                        loc, chain_starts, say)))
+    _search_leaders(got, mechs, current, data, ctx, settings, loc, say)
     for i, j in twin.items():
         say(f'{mechs[i].id}: the fit of {mechs[j].id}, judged as {mechs[i].id}')
         got[i] = _as_twin(mechs[i], got[j].fit, current, data, ctx, settings, loc)
@@ -147,6 +149,38 @@ def polish_all(pairs: list[tuple[ComposedModel, np.ndarray]], data: Data, max_nf
 def _polish_one(model: ComposedModel, data: Data, x0: np.ndarray,
                 max_nfev: int) -> tuple[np.ndarray, float, int]:
     return polish(model, data, x0, max_nfev=max_nfev)
+
+
+def _search_leaders(got: dict[int, Comparison], mechs: list[Mechanism], current: FitResult,
+                    data: Data, ctx: Context, settings: DiagnoseSettings, loc: Localization,
+                    say: Callable[[str], None]) -> None:
+    """The round's leading local fits searched jointly with the chain, judged again in place.
+
+    At most :data:`~hyst_id.diagnosis.joint.JOINT_LEADERS` of the fits worth it
+    (:func:`~hyst_id.diagnosis.joint.worth_searching`), lowest training BIC first.
+    """
+    if not settings.joint_generations:
+        return
+    bic_drop = settings.criteria.bic_drop
+    lead = sorted((i for i, c in got.items()
+                   if worth_searching(c.fit, c.delta_bic, data, bic_drop)),
+                  key=lambda i: got[i].delta_bic)[:JOINT_LEADERS]
+    if not lead:
+        return
+    say(f'{", ".join(mechs[i].id for i in lead)}: searched with the chain over the whole box')
+    args = [(got[i].fit, data, settings.joint_generations, 2 * settings.fit_budget)
+            for i in lead]
+    workers = n_processes(settings.workers, len(lead))
+    fits = ([_search(*a) for a in args] if workers <= 1
+            else map_in_processes(_search, args, workers))
+    for i, fit in zip(lead, fits):
+        if fit is not got[i].fit and fit.sse_train < got[i].fit.sse_train:
+            got[i] = judge(mechs[i], current, fit, data, ctx, settings, loc, got[i].screened)
+
+
+def _search(fit: FitResult, data: Data, generations: int, polish_nfev: int) -> FitResult:
+    """:func:`~hyst_id.diagnosis.joint.joint_search` (module level: for worker processes)."""
+    return joint_search(fit, data, generations=generations, polish_nfev=polish_nfev)
 
 
 def try_mechanism(m: Mechanism, current: FitResult, data: Data, ctx: Context,
