@@ -42,7 +42,11 @@ from hyst_id.commands.common import (
 )
 from hyst_id.errors import ConfigError
 
-__all__ = ['add_arguments', 'run']
+__all__ = ['add_arguments', 'MAX_JOINT_GENERATIONS', 'run']
+
+#: Most generations of the joint search (``--joint-generations``): beyond 33 times the
+#: default a typo is likelier than a wish.
+MAX_JOINT_GENERATIONS = 10000
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -57,6 +61,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                    help='mechanisms to test (default: all of them)')
     g.add_argument('--max-mechanisms', type=int, default=2,
                    help='most mechanisms added one after the other (default 2)')
+    g.add_argument('--joint-generations', type=int, default=300, metavar='N',
+                   help="generations of each round's joint search of its leading blocks "
+                   'with the chain over the whole box (default 300; 0: none, faster)')
     add_output_arguments(g, 'the diagnosis', 'FILE.png|DIR:write the figure')
     g.add_argument('--params-out', metavar='FILE.yaml',
                    help="compensator params file: the final model's H and B with the "
@@ -79,6 +86,9 @@ def _settings(args: argparse.Namespace):
         raise ConfigError('--max-mechanisms must be at least 1')
     if args.hops < 0:
         raise ConfigError('--hops must be at least 0')
+    if not 0 <= args.joint_generations <= MAX_JOINT_GENERATIONS:
+        raise ConfigError(f'--joint-generations must be 0 to {MAX_JOINT_GENERATIONS}, got '
+                          f'{args.joint_generations}')
     if args.workers < 0:
         raise ConfigError(f'--workers must be >= 0 (0: one per core), got {args.workers}')
     mechs = None
@@ -93,7 +103,8 @@ def _settings(args: argparse.Namespace):
         seeds=tuple(range(args.seed_offset, args.seed_offset + args.seeds)),
         generations=args.generations, pop_size=args.pop_size, workers=args.workers,
         mechanisms=mechs, max_mechanisms=args.max_mechanisms, hops=args.hops,
-        more_starts=args.more_starts, start_state=not args.whole_record)
+        more_starts=args.more_starts, start_state=not args.whole_record,
+        joint_generations=args.joint_generations)
 
 
 def _write_params(diag, path: str) -> None:

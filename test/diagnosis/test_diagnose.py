@@ -378,6 +378,9 @@ def test_cli_errors_are_one_line(tmp_path, capsys):
     assert 'supply_decay cannot act on the position channel' in err[-1], err
     assert main(['diagnose', str(csv), '--hops', '-1', '--quiet']) == 2
     assert '--hops must be at least 0' in capsys.readouterr().err
+    for bad in ('-1', '10001'):
+        assert main(['diagnose', str(csv), '--joint-generations', bad, '--quiet']) == 2
+        assert '--joint-generations must be 0 to 10000, got ' + bad in capsys.readouterr().err
     # an empty name is not "all of them", an output without its input is not ignored
     for bad in ('', 'dead_time,,'):
         assert main(['diagnose', str(csv), '--mechanisms', bad, '--quiet']) == 2
