@@ -36,7 +36,7 @@ setup(
     install_requires=[
         'setuptools',
         'numpy>=1.24',
-        'scipy>=1.11',
+        'scipy>=1.15',
         'numba>=0.59',
         'mcap>=1.1',
         'mcap-ros2-support>=0.5',

@@ -62,7 +62,8 @@ def main() -> None:
     d = draw(args.index)
     rec = Recording(d['t'], d['command'], d['measurement'], d['channel'],
                     source=f'blind #{args.index}')
-    settings = replace(DiagnoseSettings(workers=1), joint_generations=0)
+    # no start cut, so that the model's record is the whole recording
+    settings = replace(DiagnoseSettings(workers=1), joint_generations=0, start_state=False)
     print(f'blind #{args.index}: {d["channel"]}, {d["excitation"]}, effects {d["effects"]}; '
           'diagnosing without the joint search ...', flush=True)
     got = diagnose(rec, settings=settings)
@@ -72,11 +73,14 @@ def main() -> None:
     a, b = fit.model.ctx.command_scale
     v = (rec.command - b) / a
     y = rec.measurement
-    sigma = noise_std(y)
+    sigma = noise_std(y) or 1e-12 * float(np.max(np.abs(y)))     # as the diagnosis's
     data = Data(t_s=rec.t_s, v=v, y=y, n_train=n, noise_std=sigma, judged=inside_rows(v, n))
     for mid in args.without:
         if mid in fit.model.slices:
-            fit = without(fit, mid, data, max_nfev=2 * settings.fit_budget)
+            less = without(fit, mid, data, max_nfev=2 * settings.fit_budget)
+            if less is None:
+                sys.exit(f'the final model without {mid} is not feasible: nothing to search')
+            fit = less
     f_tr, f_ho = floor_percent(y[:n], sigma), floor_percent(y[n:], sigma)
 
     def line(name, f, seconds=None):

@@ -40,7 +40,10 @@ may be a basin's share); the search's fit replaces the local one, and the
 candidate is judged again, when it is better on the training part and not
 worse on the judged held-out samples (the rule of
 :func:`hyst_id.diagnosis.refit.reidentify`). Only the leaders, for time: a
-search costs seconds (``docs/diagnosis.md``, "The joint search").
+search costs seconds (``docs/diagnosis.md``, "The joint search"). The exchanges
+(:mod:`.exchange`) fit their rivals through the same round, so a rival is searched
+too. A model whose H family was swapped (``loop_shape``, ``bouc_wen``) is not searched,
+as :mod:`.refit` does not re-identify it: its chain has its own baseline fit.
 
 Most of the box violates the chain's constraints (about 1 % of uniform
 points are feasible), so the search needs its generations: on #175, 200 of
@@ -49,11 +52,14 @@ them left the start in place, 300 left it in each of four streams.
 
 from __future__ import annotations
 
+from typing import Callable
+
 import numpy as np
 from scipy.optimize import differential_evolution
 from threadpoolctl import threadpool_limits
 
 from hyst_id.diagnosis.select import Data, evaluate, FitResult, polish, training_sse
+from hyst_id.identification.workers import WorkersStopped
 from hyst_id.signals.noise import floor_percent
 
 __all__ = ['JOINT_ABOVE', 'JOINT_LEADERS', 'JOINT_POPSIZE', 'joint_search', 'worth_searching']
@@ -82,14 +88,14 @@ def worth_searching(fit: FitResult, delta_bic: float, data: Data, bic_drop: floa
     bic_drop : float
         The criteria's BIC drop.
     """
-    if fit.model is None or fit.model.swapped_by or delta_bic >= -bic_drop:
+    if fit.model is None or fit.model.swapped_by or not delta_bic < -bic_drop:
         return False
     return fit.er_train_percent > JOINT_ABOVE * floor_percent(data.y[:data.n_train],
                                                               data.noise_std)
 
 
 def joint_search(fit: FitResult, data: Data, *, generations: int, polish_nfev: int,
-                 seed: int = 0) -> FitResult:
+                 seed: int = 0, should_stop: Callable[[], bool] | None = None) -> FitResult:
     """``fit``'s model searched over its whole box, started from its values; the better fit.
 
     Parameters
@@ -104,17 +110,21 @@ def joint_search(fit: FitResult, data: Data, *, generations: int, polish_nfev: i
         Least-squares evaluations of the polish after the search.
     seed : int, optional
         The search's random stream.
+    should_stop : callable, optional
+        Looked at after every generation; when it holds the search ends and
+        :class:`~hyst_id.identification.workers.WorkersStopped` is raised.
 
     Returns
     -------
     FitResult
         The search's fit when it is better on the training part and not worse on
-        the judged held-out samples; else ``fit``.
+        the judged held-out samples; else ``fit`` (also for a model with a swapped
+        family, as :mod:`.refit` leaves those, or no feasible start).
     """
     model = fit.model
-    if model is None or generations <= 0:
+    if model is None or model.swapped_by or generations <= 0:
         return fit
-    cost = training_sse(model, data, fit.p)
+    cost = training_sse(model, data)
     x0 = np.clip(fit.p, model.bounds[:, 0], model.bounds[:, 1])
     if not model.feasible(x0):
         return fit
@@ -122,14 +132,18 @@ def joint_search(fit: FitResult, data: Data, *, generations: int, polish_nfev: i
         res = differential_evolution(cost, model.bounds, maxiter=generations,
                                      popsize=JOINT_POPSIZE, tol=0.0, atol=0.0, polish=False,
                                      x0=x0, init='latinhypercube', updating='deferred',
-                                     rng=np.random.default_rng([seed, 14, 17]))
-    p = np.asarray(res.x, dtype=float)
-    if not model.feasible(p):
+                                     rng=np.random.default_rng([seed, 14, 17]),
+                                     callback=None if should_stop is None
+                                     else (lambda intermediate_result: bool(should_stop())))
+        if should_stop is not None and should_stop():
+            raise WorkersStopped('stopped on request in the joint search')
+        p = np.asarray(res.x, dtype=float)
+        if not model.feasible(p):
+            return fit
+        p, _, nfev = polish(model, data, p, max_nfev=polish_nfev)
+        got = evaluate(model, data, p, fit.nfev + int(res.nfev) + nfev)
+    if not got.sse_train < fit.sse_train:       # NaN included
         return fit
-    p, _, nfev = polish(model, data, p, max_nfev=polish_nfev)
-    got = evaluate(model, data, p, fit.nfev + int(res.nfev) + nfev)
-    if got.sse_train >= fit.sse_train:
-        return fit
-    if data.n_holdout and data.judged_er_percent(got) > data.judged_er_percent(fit):
+    if data.n_holdout and not data.judged_er_percent(got) <= data.judged_er_percent(fit):
         return fit
     return got

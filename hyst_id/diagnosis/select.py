@@ -228,14 +228,13 @@ class _Objective:
         return float(r @ r)
 
 
-def training_sse(model: ComposedModel, data: Data, p_base: np.ndarray
-                 ) -> Callable[[np.ndarray], float]:
+def training_sse(model: ComposedModel, data: Data) -> Callable[[np.ndarray], float]:
     """The training part's sum of squared residuals as a function of all of ``model``'s values.
 
     The linear part is solved at each point; an infeasible point costs the
     residual of a prediction ten times the measurement's RMS off.
     """
-    return _Objective(model, data, p_base, np.arange(model.n_params)).sse
+    return _Objective(model, data, np.zeros(model.n_params), np.arange(model.n_params)).sse
 
 
 def polish(model: ComposedModel, data: Data, p0: np.ndarray, *, free: np.ndarray | None = None,

@@ -157,9 +157,13 @@ def _search_leaders(got: dict[int, Comparison], mechs: list[Mechanism], current:
     """The round's leading local fits searched jointly with the chain, judged again in place.
 
     At most :data:`~hyst_id.diagnosis.joint.JOINT_LEADERS` of the fits worth it
-    (:func:`~hyst_id.diagnosis.joint.worth_searching`), lowest training BIC first.
+    (:func:`~hyst_id.diagnosis.joint.worth_searching`), lowest training BIC first. The
+    searched fit is kept when it is better on the training part and, judged again, loses
+    nothing: an accepted block stays accepted (else the local fit is kept), and a first
+    filter on a static chain in the ``after`` hold must still do more than the hold's
+    one-sample shift (:func:`_filter_beats_shift`).
     """
-    if not settings.joint_generations:
+    if settings.joint_generations <= 0:
         return
     bic_drop = settings.criteria.bic_drop
     lead = sorted((i for i, c in got.items()
@@ -171,16 +175,31 @@ def _search_leaders(got: dict[int, Comparison], mechs: list[Mechanism], current:
     args = [(got[i].fit, data, settings.joint_generations, 2 * settings.fit_budget)
             for i in lead]
     workers = n_processes(settings.workers, len(lead))
-    fits = ([_search(*a) for a in args] if workers <= 1
-            else map_in_processes(_search, args, workers))
+    fits = ([_search(*a, should_stop=settings.should_stop) for a in args] if workers <= 1
+            else map_in_processes(_search, args, workers, should_stop=settings.should_stop))
     for i, fit in zip(lead, fits):
-        if fit is not got[i].fit and fit.sse_train < got[i].fit.sse_train:
-            got[i] = judge(mechs[i], current, fit, data, ctx, settings, loc, got[i].screened)
+        m, local = mechs[i], got[i]
+        if not fit.sse_train < local.fit.sse_train:
+            continue
+        static = current.model is not None and not current.model.dynamic
+        if (fit.model.hold == 'after' and static and m.stage == 'sensor'
+                and not _filter_beats_shift(fit, m, data)):
+            say(f'{m.id}: the search made it a one-sample delay; its local fit kept')
+            continue
+        again = judge(m, current, fit, data, ctx, settings, loc, local.screened)
+        if local.accepted and not again.accepted:
+            say(f'{m.id}: the searched fit is {again.status}; its accepted local fit kept')
+            continue
+        say(f'{m.id}: searched, training %e_r {local.fit.er_train_percent:.4g} -> '
+            f'{fit.er_train_percent:.4g}, {again.status}')
+        got[i] = again
 
 
-def _search(fit: FitResult, data: Data, generations: int, polish_nfev: int) -> FitResult:
+def _search(fit: FitResult, data: Data, generations: int, polish_nfev: int,
+            should_stop: Callable[[], bool] | None = None) -> FitResult:
     """:func:`~hyst_id.diagnosis.joint.joint_search` (module level: for worker processes)."""
-    return joint_search(fit, data, generations=generations, polish_nfev=polish_nfev)
+    return joint_search(fit, data, generations=generations, polish_nfev=polish_nfev,
+                        should_stop=should_stop)
 
 
 def try_mechanism(m: Mechanism, current: FitResult, data: Data, ctx: Context,

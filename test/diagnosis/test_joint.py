@@ -29,14 +29,16 @@ import numpy as np
 import pytest
 from reference_sim import backlash, hysteresis
 
-from hyst_id.diagnosis import diagnose, DiagnoseSettings
+from hyst_id.diagnosis import diagnose, DiagnoseSettings, trial
 from hyst_id.diagnosis.joint import JOINT_ABOVE, joint_search, worth_searching
+from hyst_id.diagnosis.locate import locate
 from hyst_id.diagnosis.mechanisms.base import Context
 from hyst_id.diagnosis.mechanisms.registry import MECHANISMS
 from hyst_id.diagnosis.model import ComposedModel
-from hyst_id.diagnosis.select import Data, evaluate, polish
+from hyst_id.diagnosis.select import Data, evaluate
 from hyst_id.identification.chains import chain_spec
 from hyst_id.io.recording import Recording
+from hyst_id.signals.noise import floor_percent
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / 'bench'))
 import blind_family  # noqa: E402, I100
@@ -62,18 +64,63 @@ def _delayed_record(seed: int = 0):
     return data, model
 
 
-def test_the_search_is_never_worse_and_none_is_nothing():
-    data, model = _delayed_record()
-    # a start in the wrong place: the delay at a tenth of the truth, the chain polished
-    p0, _, _ = polish(model, data, np.concatenate([CHAIN, [0.03]]), max_nfev=200)
-    start = evaluate(model, data, p0)
+def test_the_search_reaches_the_floor_from_a_start_off_it_and_repeats_itself():
+    """From the delay at a tenth of the truth, unpolished (92.5 x the training floor).
+
+    Measured at 150 generations on noise seeds 0-3: 1.112-1.119 x the floor, the delay
+    0.3009-0.3012 s (at 60 generations seed 3 stayed at 29.7 x with 0.47 s).
+    """
+    data, model = _delayed_record(seed=1)
+    start = evaluate(model, data, np.concatenate([CHAIN, [0.03]]))
+    floor = floor_percent(data.y[:data.n_train], NOISE)
+    assert start.er_train_percent > 50 * floor
     assert joint_search(start, data, generations=0, polish_nfev=400) is start
-    got = joint_search(start, data, generations=60, polish_nfev=400)
-    assert got.sse_train <= start.sse_train
-    assert data.judged_er_percent(got) <= data.judged_er_percent(start)
+    got = joint_search(start, data, generations=150, polish_nfev=400)
+    assert got is not start and got.sse_train < start.sse_train
+    assert got.er_train_percent < 1.3 * floor
+    assert got.p[-1] == pytest.approx(0.3, abs=0.005)
     # the same stream gives the same answer
-    again = joint_search(start, data, generations=60, polish_nfev=400)
+    again = joint_search(start, data, generations=150, polish_nfev=400)
     np.testing.assert_array_equal(again.p, got.p)
+
+
+def test_a_round_judges_its_leaders_again_on_their_searched_fits(monkeypatch):
+    """The wiring of ``trial._search_leaders``, the search replaced by a known better fit."""
+    data, model = _delayed_record(seed=1)
+    plain = ComposedModel('position', [], model.ctx, chain_spec('position').bounds)
+    current = evaluate(plain, data, CHAIN)
+    local = evaluate(model, data, np.concatenate([CHAIN, [0.2]]))
+    better = evaluate(model, data, np.concatenate([CHAIN, [0.3]]))
+    searched = []
+
+    def fake(fit, data, *, generations, polish_nfev, should_stop=None):
+        searched.append((fit, generations))
+        return better
+
+    monkeypatch.setattr(trial, 'joint_search', fake)
+    settings = DiagnoseSettings(workers=1)
+    m = MECHANISMS['dead_time']
+    loc = locate(data.t_s, data.v, data.y, current.prediction, NOISE, data.n_train, 7.0)
+    comp = trial.judge(m, current, local, data, model.ctx, settings, loc)
+    assert comp.accepted
+    comp.screened = 'kept'
+    said: list[str] = []
+    got = {0: comp}
+    trial._search_leaders(got, [m], current, data, model.ctx, settings, loc, said.append)
+    assert [g for _, g in searched] == [300] and searched[0][0] is local
+    assert got[0].fit is better and got[0].screened == 'kept' and got[0].accepted
+    assert any(line.startswith('dead_time: searched') for line in said), said
+    # a searched fit no better on training is not taken
+    monkeypatch.setattr(trial, 'joint_search', lambda fit, *a, **k: local)
+    got = {0: comp}
+    trial._search_leaders(got, [m], current, data, model.ctx, settings, loc, said.append)
+    assert got[0] is comp
+    # none: nothing searched
+    searched.clear()
+    monkeypatch.setattr(trial, 'joint_search', fake)
+    trial._search_leaders(got, [m], current, data, model.ctx,
+                          DiagnoseSettings(workers=1, joint_generations=0), loc, said.append)
+    assert not searched and got[0] is comp
 
 
 def test_only_a_fit_that_found_something_and_stays_above_the_floor_is_searched():
