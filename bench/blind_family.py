@@ -190,11 +190,14 @@ def draw(index: int, only: frozenset | None = None) -> dict:
             'chain_params': p, 'reference_command': v}
 
 
-def run(index: int, workers: int = 1, more_starts: bool = False) -> dict:
+def run(index: int, workers: int = 1, more_starts: bool = False,
+        joint_generations: int = 0) -> dict:
     """Draw and diagnose one recording (``workers`` processes); what the tables need.
 
     ``more_starts``: the baseline's identify builds more chains from the data
     (``DiagnoseSettings.more_starts``; off, as by default, in the documented run).
+    ``joint_generations``: the joint search (``DiagnoseSettings.joint_generations``;
+    off by default, 300 in the rerun of ``docs/data/blind_joint_search.json``).
     """
     from hyst_id.diagnosis import diagnose, DiagnoseSettings
     from hyst_id.diagnosis.blocked_cv import confirmed
@@ -203,7 +206,8 @@ def run(index: int, workers: int = 1, more_starts: bool = False) -> dict:
     rec = Recording(case['t'], case['command'], case['measurement'], case['channel'],
                     source=f'blind #{index}')
     t0 = time.time()
-    d = diagnose(rec, settings=DiagnoseSettings(workers=workers, more_starts=more_starts))
+    d = diagnose(rec, settings=DiagnoseSettings(workers=workers, more_starts=more_starts,
+                                                joint_generations=joint_generations))
     j = d.extra['judged_holdout']
     out = {k: case[k] for k in ('index', 'channel', 'excitation', 'dt_s', 'effects',
                                 'magnitudes', 'noise_percent_of_span')}
@@ -532,6 +536,9 @@ def main() -> int:
     ap.add_argument('--more-starts', action='store_true',
                     help="with --indices: the baseline's identify builds more chains from the "
                          'data (DiagnoseSettings.more_starts; docs/diagnosis.md, section 1)')
+    ap.add_argument('--joint-generations', type=int, default=0, metavar='N',
+                    help="with --indices: the joint search of each round's leading blocks "
+                         '(DiagnoseSettings.joint_generations; docs/diagnosis.md, section 4)')
     ap.add_argument('--stop-after-min', type=float, default=float('inf'), metavar='M',
                     help='start no new recording after M minutes (a full run resumes from '
                          'docs/diagnosis_blind.partial.jsonl next time)')
@@ -582,8 +589,9 @@ def main() -> int:
         how = f'one at a time in {ks.pop()} processes' if len(ks) == 1 else 'one worker each'
         print(summary(rows, how) if rows else 'none')
         return 0
-    if args.more_starts and not args.indices:
-        print('--more-starts only with --indices (the documented run uses the defaults)')
+    if (args.more_starts or args.joint_generations) and not args.indices:
+        print('--more-starts and --joint-generations only with --indices (the documented '
+              'run uses the defaults)')
         return 2
     if args.against:
         print('--against only with --compare')
@@ -593,7 +601,8 @@ def main() -> int:
         return 2
     indices = args.indices or list(range(args.n))
     k = args.diagnose_workers
-    one = functools.partial(run, more_starts=args.more_starts)
+    one = functools.partial(run, more_starts=args.more_starts,
+                            joint_generations=args.joint_generations)
     how = 'one worker each' if k <= 1 else f'one at a time in {k} processes'
     full = not (args.no_write or args.indices)
     if k <= 1:

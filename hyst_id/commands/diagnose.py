@@ -61,9 +61,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                    help='mechanisms to test (default: all of them)')
     g.add_argument('--max-mechanisms', type=int, default=2,
                    help='most mechanisms added one after the other (default 2)')
-    g.add_argument('--joint-generations', type=int, default=300, metavar='N',
+    g.add_argument('--joint-generations', type=int, default=0, metavar='N',
                    help="generations of each round's joint search of its leading blocks "
-                   'with the chain over the whole box (default 300; 0: none, faster)')
+                   'with the chain over the whole box (300 finds what the local fits miss '
+                   'where the chain absorbed the effect, at seconds per search; default 0: '
+                   'none)')
     add_output_arguments(g, 'the diagnosis', 'FILE.png|DIR:write the figure')
     g.add_argument('--params-out', metavar='FILE.yaml',
                    help="compensator params file: the final model's H and B with the "

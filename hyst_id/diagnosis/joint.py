@@ -45,6 +45,10 @@ search costs seconds (``docs/diagnosis.md``, "The joint search"). The exchanges
 too. A model whose H family was swapped (``loop_shape``, ``bouc_wen``) is not searched,
 as :mod:`.refit` does not re-identify it: its chain has its own baseline fit.
 
+Off by default (``DiagnoseSettings.joint_generations`` 0; ``diagnose
+--joint-generations 300`` turns it on): its seconds, two searches a round, made the test
+suite's diagnoses too slow for its time budget.
+
 Most of the box violates the chain's constraints (about 1 % of uniform
 points are feasible), so the search needs its generations: on #175, 200 of
 them left the start in place, 300 left it in each of four streams.

@@ -98,7 +98,7 @@ def test_a_round_judges_its_leaders_again_on_their_searched_fits(monkeypatch):
         return better
 
     monkeypatch.setattr(trial, 'joint_search', fake)
-    settings = DiagnoseSettings(workers=1)
+    settings = DiagnoseSettings(workers=1, joint_generations=300)
     m = MECHANISMS['dead_time']
     loc = locate(data.t_s, data.v, data.y, current.prediction, NOISE, data.n_train, 7.0)
     comp = trial.judge(m, current, local, data, model.ctx, settings, loc)
@@ -153,6 +153,6 @@ def test_friction_behind_a_slow_pressure_sensor_is_found_by_the_joint_search():
     assert case['effects'] == ['friction']
     rec = Recording(case['t'], case['command'], case['measurement'], case['channel'],
                     source='blind #175')
-    d = diagnose(rec, settings=DiagnoseSettings(workers=1))
+    d = diagnose(rec, settings=DiagnoseSettings(workers=1, joint_generations=300))
     assert [f.mechanism for f in d.findings] == ['friction'], d.report()
     assert d.final.er_holdout_percent < 2.5 * d.noise_floor_percent, d.report()
