@@ -137,6 +137,7 @@ def test_only_a_fit_that_found_something_and_stays_above_the_floor_is_searched()
 
 
 @pytest.mark.slow
+@pytest.mark.thorough     # 80 s, for an option that is off by default
 def test_friction_behind_a_slow_pressure_sensor_is_found_by_the_joint_search():
     """Blind #175: friction alone (8 % of the span), pressure sensor 5.8 s, random steps.
 
