@@ -89,8 +89,8 @@ class DiagnoseSettings:
         candidate's local fit lowers the training BIC yet stays above the floor;
         0 (the default): none. 300 found friction on three blind recordings
         the local fits had missed (#162, #164, #175) at seconds per search, two
-        per round: on by default it made the test suite's diagnoses so much
-        slower that the suite no longer fit its 30 minutes (docs/diagnosis.md).
+        per round: on by default it slowed the test suite's diagnoses by about
+        two fifths, beyond its 30 minutes (docs/diagnosis.md).
     should_stop : callable, optional
         Passed to the baseline's identifications (``identify(should_stop=...)``:
         looked at before each jump of hopping and each generation of an
