@@ -68,7 +68,9 @@ def test_the_search_reaches_the_floor_from_a_start_off_it_and_repeats_itself():
     """From the delay at a tenth of the truth, unpolished (92.5 x the training floor).
 
     Measured at 150 generations on noise seeds 0-3: 1.112-1.119 x the floor, the delay
-    0.3009-0.3012 s (at 60 generations seed 3 stayed at 29.7 x with 0.47 s).
+    0.3009-0.3012 s (at 60 generations seed 3 stayed at 29.7 x with 0.47 s); seed 1 with
+    its measurement perturbed by 1e-14 relative in four streams (another CPU's last bits
+    change the search's path): 1.002-1.113 x, 0.3002-0.3012 s. The bounds sit outside.
     """
     data, model = _delayed_record(seed=1)
     start = evaluate(model, data, np.concatenate([CHAIN, [0.03]]))
@@ -127,8 +129,7 @@ def test_only_a_fit_that_found_something_and_stays_above_the_floor_is_searched()
     data, model = _delayed_record()
     true = evaluate(model, data, np.concatenate([CHAIN, [0.3]]))
     off = evaluate(model, data, np.concatenate([CHAIN, [0.2]]))
-    floor = 100.0 * NOISE * np.sqrt(data.n_train / float(data.y[:data.n_train] @
-                                                         data.y[:data.n_train]))
+    floor = floor_percent(data.y[:data.n_train], NOISE)
     assert true.er_train_percent < JOINT_ABOVE * floor < off.er_train_percent
     assert not worth_searching(true, -500.0, data, 10.0)     # at the floor
     assert worth_searching(off, -500.0, data, 10.0)
