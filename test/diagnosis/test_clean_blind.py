@@ -65,9 +65,12 @@ FINAL_WITHIN = 1.2
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize('index', [59, 63])
+@pytest.mark.parametrize('index', [pytest.param(59, marks=pytest.mark.thorough), 63])
 def test_a_clean_reference_recording_gets_verdict_none(index):
-    """No finding at all, and a final model at the floor on the judged held-out part."""
+    """No finding at all, and a final model at the floor on the judged held-out part.
+
+    #59 is in the thorough tier: the default run diagnoses it with more starts below.
+    """
     case = blind_family.draw(index)
     assert case['effects'] == []
     rec = Recording(case['t'], case['command'], case['measurement'], case['channel'],

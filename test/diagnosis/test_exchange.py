@@ -89,8 +89,12 @@ def test_blind_24_ends_with_its_lag_and_its_curve():
 
 
 @pytest.mark.slow
+@pytest.mark.thorough
 def test_a_dead_time_beside_a_static_curve_gets_no_sensor_lag():
     """The mirror of #24: no sensor lag is put in where the record has a dead time.
+
+    Thorough tier: the default run checks that a dead time is not exchanged for a
+    sensor lag beside a static curve in ``test_the_records_own_lag_block_is_kept``.
 
     Round 1 takes ``actuator_dynamics`` here (damping at its 0.7 bound, 0.92 Hz: a
     second order standing in for a two-sample delay, final 1.05 x the floor); the

@@ -255,11 +255,14 @@ def test_identifier_publishes_the_typed_result_beside_the_json(ctx):
 
 
 @pytest.mark.slow
+@pytest.mark.thorough
 def test_replay_at_rate_4_of_stamped_streams_keeps_tau_without_a_clock(ctx, tmp_path):
     """As test_identifier_node's rate-4 replay, but stamped commands instead of /clock.
 
     Without use_sim_time the unstamped commands would be timed by their arrival,
-    4 x too fast; stamped, they keep the bag's time.
+    4 x too fast; stamped, they keep the bag's time. Thorough tier: the default run
+    checks the stamps' timing on a burst (``test_identifier_times_a_burst_...``) and
+    the rate-4 replay with /clock (``test_identifier_node``).
     """
     from reference_sim import simulate
 
