@@ -69,7 +69,10 @@ FINAL_WITHIN = 1.2
 def test_a_clean_reference_recording_gets_verdict_none(index):
     """No finding at all, and a final model at the floor on the judged held-out part.
 
-    #59 is in the thorough tier: the default run diagnoses it with more starts below.
+    #59 is in the thorough tier: #63 is the case that stays for the default settings
+    (its claim withdrawn by the challenge, as #59's ``actuator_dynamics`` is: that
+    withdrawal on #59 is checked by ``./run test-all`` only); the default run
+    diagnoses #59 with more starts below.
     """
     case = blind_family.draw(index)
     assert case['effects'] == []

@@ -93,8 +93,11 @@ def test_blind_24_ends_with_its_lag_and_its_curve():
 def test_a_dead_time_beside_a_static_curve_gets_no_sensor_lag():
     """The mirror of #24: no sensor lag is put in where the record has a dead time.
 
-    Thorough tier: the default run checks that a dead time is not exchanged for a
-    sensor lag beside a static curve in ``test_the_records_own_lag_block_is_kept``.
+    Thorough tier: the default run checks the exchange's rule beside a static curve
+    with the blocks forced in (``test_the_records_own_lag_block_is_kept[dead_time]``,
+    ``test_a_wrong_lag_block_forced_in_is_exchanged_for_the_records_own[dead_time-
+    sensor_lag]``); this diagnosis end to end, where round 1 takes
+    ``actuator_dynamics``, runs in ``./run test-all`` only.
 
     Round 1 takes ``actuator_dynamics`` here (damping at its 0.7 bound, 0.92 Hz: a
     second order standing in for a two-sample delay, final 1.05 x the floor); the

@@ -261,8 +261,10 @@ def test_replay_at_rate_4_of_stamped_streams_keeps_tau_without_a_clock(ctx, tmp_
 
     Without use_sim_time the unstamped commands would be timed by their arrival,
     4 x too fast; stamped, they keep the bag's time. Thorough tier: the default run
-    checks the stamps' timing on a burst (``test_identifier_times_a_burst_...``) and
-    the rate-4 replay with /clock (``test_identifier_node``).
+    checks the stamps' timing on a burst
+    (``test_identifier_times_a_burst_of_stamped_samples_by_their_stamps``) and the rate-4
+    replay with /clock (``test_identifier_node``); a stamped bag replayed without a
+    clock is checked by ``./run test-all`` only.
     """
     from reference_sim import simulate
 
@@ -323,6 +325,7 @@ def test_bringup_runs_stamped_streams_in_a_namespace(ros_domain, tmp_path, monke
     with open_bag(tmp_path / 'bag') as bag:
         types = dict(bag.topics)
     assert types['/valve1/hyst_id/command'] == STAMPED_VALUE_TYPE, types
+    assert all(t.startswith('/valve1/') for t in types), types    # the whole graph's topics
     assert types['/valve1/hyst_id/flow'] == STAMPED_VALUE_TYPE, types
 
 

@@ -343,8 +343,9 @@ def test_two_whole_graphs_in_two_namespaces_do_not_cross(ros_domain, tmp_path):
     """Two bringup processes (every node of the graph each) on one domain, /valve1 and /valve2.
 
     Thorough tier: the default run checks two namespaced valves in one process
-    (``test_two_namespaced_valves_do_not_cross``) and a whole graph in a namespace
-    (``test_stamped_streams``' bringup).
+    (``test_two_namespaced_valves_do_not_cross``) and every topic of a whole graph in
+    its namespace (``test_bringup_runs_stamped_streams_in_a_namespace``); two whole
+    graphs on one domain at once run in ``./run test-all`` only.
 
     Each bag holds its own namespace's streams only, with exactly its own run's
     samples (301 + 41 + 41 commands): a topic shared across the namespaces would
