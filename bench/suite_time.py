@@ -32,8 +32,10 @@ from pathlib import Path
 import sys
 import xml.etree.ElementTree as ET
 
-#: Where ``./run test --junitxml=results/suite.xml`` writes the times.
-DEFAULT_XML = Path('results/suite.xml')
+ROOT = Path(__file__).resolve().parents[1]
+#: Where ``./run test --junitxml=results/suite.xml`` writes the times (``./run`` works in
+#: the repository root).
+DEFAULT_XML = ROOT / 'results' / 'suite.xml'
 
 
 def read_times(path: Path) -> list[tuple[float, str, str, str]]:
@@ -55,13 +57,14 @@ def main(argv: list[str] | None = None) -> int:
     """Print the suite's test-seconds, per module and the slowest tests."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('xml', type=Path, nargs='?',
-                        help=f'junit XML written by pytest --junitxml (default {DEFAULT_XML})')
+                        help='junit XML written by pytest --junitxml (default '
+                             'results/suite.xml)')
     parser.add_argument('--top', type=int, default=30, help='slowest tests shown (30)')
     parser.add_argument('--files', type=int, default=25, help='slowest modules shown (25)')
     args = parser.parse_args(argv)
     if args.xml is None:
         if not DEFAULT_XML.is_file():   # as ./run bench runs it: nothing measured yet
-            print(f'no {DEFAULT_XML}: ./run test --junitxml={DEFAULT_XML} writes it')
+            print(f'no {DEFAULT_XML}: ./run test --junitxml=results/suite.xml writes it')
             return 0
         args.xml = DEFAULT_XML
     try:
