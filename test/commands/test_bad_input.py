@@ -147,6 +147,8 @@ CASES = [
     ('ragged-rows', lambda d: [str(_text(d / 'r.csv', 't,command,measurement\n0,1,2\n0.1,2\n'))],
      'line'),
     ('nan-measurement', lambda d: [str(write_csv(d / 'n.csv', y=nan_at(Y)))], 'NaN'),
+    # named as the file names the column, at its line (it had said ``t_s``, the reader's name)
+    ('nan-time', lambda d: [str(write_csv(d / 'nt.csv', t=nan_at(T)))], 'column t of'),
     ('inf-command', lambda d: [str(write_csv(d / 'i.csv', v=np.where(T > 3, np.inf, V)))],
      'NaN/inf'),
     ('duplicate-timestamps', lambda d: [str(write_csv(d / 'd.csv', t=dup_t(T)))], 'duplicate'),
@@ -199,6 +201,9 @@ CASES = [
                                          '-1'], 'global evaluations'),
     ('negative-search-samples', lambda d: [str(write_csv(d / 'ok7.csv')), '--search-samples',
                                            '-5'], 'search samples'),
+    ('negative-c', lambda d: [str(write_csv(d / 'ok21.csv')), '--c', '-1'],
+     'contraction rate c (--c) must be a finite number > 0'),
+    ('xi-above-one', lambda d: [str(write_csv(d / 'ok22.csv')), '--xi', '2'], 'xi (--xi)'),
     ('negative-hops', lambda d: [str(write_csv(d / 'ok8.csv')), '--hops', '-1'], 'hops >= 0'),
     ('bad-columns-option', lambda d: [str(write_csv(d / 'ok5.csv')), '--columns', 't,command'],
      'three'),
@@ -474,3 +479,12 @@ def test_huge_generations_are_refused_before_any_work(tmp_path, capsys):
     assert main(['identify', str(csv), '--quiet', '--generations', '100000000']) == 2
     err = capsys.readouterr().err
     assert 'generations <= 1000000' in err and 'internal error' not in err
+
+
+@pytest.mark.parametrize('flag, value', [('--c', '-1'), ('--c', 'nan'), ('--xi', '0')])
+def test_bad_gaass_rates_are_refused_before_the_domains_are_printed(tmp_path, capsys, flag, value):
+    """``--c -1`` was refused by GAASS itself, after the domains and a bar were printed."""
+    csv = write_csv(tmp_path / 'run.csv')
+    assert main(['identify', str(csv), flag, value]) == 2
+    err = capsys.readouterr().err
+    assert flag + ')' in err and 'search domains' not in err and 'GAASS seeds' not in err, err
