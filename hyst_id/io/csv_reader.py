@@ -239,6 +239,12 @@ def read_csv(path: str | Path, channel: str, *,
                 raise RecordingError(f'non-numeric value {cells[i]!r} in column {labels[j]} '
                                      f'at line {lineno} of {path}')
             data[r, j] = value
+    for j, label in enumerate(labels):      # named as the file names it, at its line
+        bad = ~np.isfinite(data[:, j])
+        if bad.any():
+            first = int(np.argmax(bad))
+            raise RecordingError(f'column {label} of {path} has {int(bad.sum())} NaN/inf '
+                                 f'values (first {data[first, j]} at line {rows[first][0]})')
     note = (f'columns: t_s = {labels[0]} x {time_scale:g}, command = {labels[1]}, '
             f'measurement = {labels[2]}')
     row_units = [unit_row[i] for i in index] if unit_row else ['', '', '']
