@@ -229,12 +229,18 @@ class Compensator:
         model, inv = self._active
         if model is not None:
             m_bl, c_bl, c_br = model.backlash
-        if model is None or self.bypass:
+        if not math.isfinite(desired):
+            v = math.nan                        # held: a non-finite value is never sent
+        elif model is None or self.bypass:
             v = float(desired)
         else:
             target = model.output_sign * desired
             u_d = backlash_inverse_step(target, self._y, self._u, m_bl, c_bl, c_br)
             v = inv.command_for(u_d)
+            if not math.isfinite(v) and not math.isnan(u_d):
+                # a finite desired value far beyond the loop (1e308) overflows the inverse:
+                # toward the limit on its side, as a reachable-but-large one goes
+                v = math.inf if u_d > self._u else -math.inf
         v = self._limit(v, t_s)
         if model is not None:
             self._u = inv.advance(v)
@@ -244,7 +250,7 @@ class Compensator:
 
     def _limit(self, v: float, t_s: float | None) -> float:
         lim = self.limits
-        if not math.isfinite(v):
+        if math.isnan(v):
             v = self._v
         if t_s is not None and math.isfinite(lim.max_rate_per_s):
             # the first sample after a reset starts from the held command: no time has
@@ -254,7 +260,8 @@ class Compensator:
             v = min(max(v, self._v - dv_max), self._v + dv_max)
         if t_s is not None:
             self._t_prev = t_s
-        return min(max(v, lim.min_command), lim.max_command)
+        v = min(max(v, lim.min_command), lim.max_command)
+        return v if math.isfinite(v) else self._v     # an infinite side without a limit
 
     def run(self, desired: np.ndarray, t_s: np.ndarray | None = None) -> np.ndarray:
         """Commands for a whole desired sequence (convenience over :meth:`step`)."""

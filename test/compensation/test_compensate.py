@@ -62,6 +62,31 @@ def test_the_rate_limit_starts_from_the_held_command():
     assert comp.step(4.0, 201.0) == pytest.approx(11.0)
 
 
+@pytest.mark.parametrize('sign', [1.0, -1.0])
+@pytest.mark.parametrize('rate', [np.inf, 1.0])
+def test_a_desired_value_beyond_any_reach_goes_to_the_limit_on_its_side(sign, rate):
+    """1e308 overflowed the inverse and held the last command; 1e6 went to the limit.
+
+    A non-finite desired value is still held (never sent); with no limit on a
+    side, an overflow toward it holds too.
+    """
+    def after(desired, limits):
+        comp = Compensator(InverseModel.from_vector(CANON, output_sign=sign), limits, v0=9.0)
+        comp.step(sign * 9.0, 0.0)
+        held = comp.state[0]
+        return comp.step(desired, 1.0), held
+
+    limits = CommandLimits(4.0, 20.0, max_rate_per_s=rate)
+    for big in (1e6, 1e308, np.finfo(float).max):
+        assert after(sign * big, limits)[0] == after(sign * 1e6, limits)[0] > 9.0
+        assert after(-sign * big, limits)[0] == after(-sign * 1e6, limits)[0] < 9.0
+    for bad in (np.inf, -np.inf, np.nan):
+        got, held = after(bad, limits)
+        assert got == held
+    got, held = after(sign * 1e308, CommandLimits())
+    assert got == held
+
+
 def test_no_model_passes_through():
     comp = Compensator(None, CommandLimits(0.0, 20.0), v0=9.0)
     np.testing.assert_array_equal(comp.run(DESIRED), DESIRED)
