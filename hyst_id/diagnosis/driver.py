@@ -115,7 +115,7 @@ def _info(fit: FitResult, ctx: Context, command: np.ndarray) -> dict:
     return {'coef': fit.coef, 'labels': fit.labels, 'span': fit.span, 'x_chain': x_chain,
             'to_meas': to_meas, 'meas_per_pos': float((ends[1] - ends[0]) / (hi - lo)),
             'pos_per_cmd': pos_per_cmd, 'command': command, 'travel_raw': fit.travel_raw,
-            'readings_median': float(np.median(fit.prediction[:ctx.n_train]))}
+            'readings_median': ctx.extra.get('readings_median')}   # the doubt's (trial.judge)
 
 
 def located_where(loc: Localization, own: dict) -> dict:
@@ -213,7 +213,8 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
     ctx = Context(channel=rec.channel, t_s=t, n_train=n_train, command_scale=scale,
                   command_unit=rec.command_unit, measurement_unit=rec.measurement_unit,
                   measurement_name=rec.measurement_name,
-                  extra=command_context(t[:n_train], v[:n_train]))
+                  extra={**command_context(t[:n_train], v[:n_train]),
+                         'readings_median': float(np.median(y[:n_train]))})
     sigma = noise_std(y) or 1e-12 * float(np.max(np.abs(y)))    # noise-free: no 0 floor
     data = Data(t_s=t, v=v, y=y, n_train=n_train, noise_std=sigma,
                 judged=inside_rows(v, n_train))

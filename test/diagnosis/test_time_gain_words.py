@@ -60,3 +60,20 @@ def test_a_supply_decay_whose_readings_rise_says_so(middle, doubted):
     if doubted:
         assert values['middle_reading'].value == 100.0
         assert 'a judgement call against a gain growing or an offset drifting' in text
+
+
+@pytest.mark.parametrize('middle', [100.0, 127.9, 128.1, 150.0])
+def test_the_doubt_and_the_words_read_the_same_middle(middle):
+    """The tie-break's doubt and the report's words judge one median: the measurement's.
+
+    The doubt (``trial.judge``) had read the training measurement's median and the
+    words (``driver._info``) the fitted prediction's: near the unchanged reading
+    the report could state a judgement call the tie-break had not made, or the reverse.
+    """
+    m = get_mechanisms(('supply_decay',), channel='pressure')[0]
+    readings = np.full(1400, middle)
+    ctx = Context('pressure', T, 1400)
+    info = {**INFO, 'readings_median': float(np.median(readings))}
+    values = m.describe(np.array([1e-3]), INFO['coef'], info, ctx)
+    doubt = m.doubt(np.array([1e-3]), INFO['coef'], INFO['labels'], readings)
+    assert bool(doubt) is ('middle_reading' in values) is (middle < 128.0)

@@ -165,3 +165,19 @@ def test_a_block_that_fits_as_another_is_judged_on_that_fit_made_once(monkeypatc
         np.testing.assert_array_equal(own.fit.coef, shared.fit.coef)
         assert own.fit.labels == shared.fit.labels and own.holdout_z == shared.holdout_z
     assert 'bouc_wen:0' in round_[1].fit.labels and round_[1].fit.model.ids[-1] == 'bouc_wen'
+
+
+def test_the_words_take_the_training_measurements_median_not_the_fits():
+    """``driver._info`` passes on the median the driver took of the measurement.
+
+    It had taken the fitted prediction's, where the supply decay's doubt
+    (``trial.judge``) reads the measurement's
+    (``test_time_gain_words.py::test_the_doubt_and_the_words_read_the_same_middle``).
+    """
+    from hyst_id.diagnosis.driver import _info
+
+    data, ctx, current, _ = delayed_case()
+    measured = float(np.median(data.y[:data.n_train]))
+    ctx.extra['readings_median'] = measured
+    assert float(np.median(current.prediction[:data.n_train])) != measured
+    assert _info(current, ctx, data.v)['readings_median'] == measured
