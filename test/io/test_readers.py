@@ -547,7 +547,8 @@ def test_nan_in_csv(tmp_path: Path) -> None:
     meas[17] = np.nan
     msg = _raises(RecordingError, read_recording, _csv(tmp_path, rec.t_s, rec.command, meas),
                   'position')
-    assert 'NaN' in msg and 'sample 17' in msg
+    # named by the file's column and line (the header is line 1: sample 17 is on line 19)
+    assert 'NaN' in msg and 'column measurement of' in msg and 'line 19' in msg, msg
 
 
 def test_backwards_and_duplicate_time_not_fixed(tmp_path: Path) -> None:
