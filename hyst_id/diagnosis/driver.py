@@ -76,6 +76,7 @@ from hyst_id.diagnosis.trial import try_all
 from hyst_id.errors import ConfigError
 from hyst_id.identification.chains import chain_spec, ChainSpec
 from hyst_id.io.recording import Recording, roundoff_probe, validate_part, validate_recording
+from hyst_id.signals.artefacts import find_artefacts
 from hyst_id.signals.noise import floor_percent
 from hyst_id.signals.reversals import command_context
 from hyst_id.signals.split import inside_rows, split_index
@@ -378,6 +379,8 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
                      measurement_unit=rec.measurement_unit, command_unit=rec.command_unit,
                      measurement_name=rec.measurement_name, command_name=rec.command_name,
                      notes=notes, extra={**extra, 'command_scale': list(scale),
+                                         'artefacts': [a.to_dict() for a in find_artefacts(
+                                             t, v_orig, y, rec.measurement_unit)],
                                          'hold': current.model.hold
                                          if current.model.dynamic else '',
                                          'judged_holdout': _judged(data, baseline, current)})

@@ -218,6 +218,8 @@ def format_diagnosis(d: Any) -> str:
                  f'train (noise std {d.noise_std:.3g}{" " + unit if unit else ""})')
     y_train = (d.baseline.prediction + d.baseline.residual)[:nt]
     lines += [f'warning: {w}' for w in response_warnings(d.baseline.er_train_percent, y_train)]
+    artefacts = d.extra.get('artefacts', [])
+    lines += [f"measurement artefact ({a['kind']}): {a['words']}" for a in artefacts]
     loop_words = d.measured_loop.words(d.measurement_name or 'measurement', unit)
     lines.append(f'{loop_words} (from the data alone)')
     lines += ['', 'where the baseline departs from the measurement:']
@@ -234,6 +236,9 @@ def format_diagnosis(d: Any) -> str:
                          f'({ratio:.2f} x the noise floor on held-out data) and no mechanism '
                          'of the library explains it (table below); where it shows is above.')
             lines += [f'  - {x}' for x in _unknown_lines(d)]
+            lines += [f"  - the measurement's {a['kind']} samples (above) may carry it: "
+                      'the sensor or the logger, which no block of the library models'
+                      for a in artefacts if a['n_samples']]
             lines += _withdrawn_lines(d)
         elif 'whole_record' in d.extra:
             ratio = over(d.final.er_holdout_percent, d.noise_floor_percent)

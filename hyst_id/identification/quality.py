@@ -17,6 +17,9 @@
 :func:`identification_warnings` returns one-line sentences for
 ``Identification.warnings`` (the report prints them):
 
+* **measurement artefacts** -- frozen or clipped stretches, glitches, a
+  coarse A/D, irregular sampling (:func:`hyst_id.signals.artefacts.find_artefacts`):
+  the sensor or the logger, not the plant; first, as they colour every figure after.
 * **loop shape** -- in the sign identified (``output_sign``) the model's loop
   runs counter-clockwise and its output never moves against the command
   right after a reversal; a friction force against displacement does both.
@@ -47,6 +50,7 @@ from hyst_id.identification.chains import ChainSpec
 from hyst_id.identification.loop import loop_orientation, reversal_response
 from hyst_id.identification.refine import refine
 from hyst_id.identification.result import Identification
+from hyst_id.signals.artefacts import find_artefacts
 from hyst_id.signals.noise import estimate_noise_std
 from hyst_id.signals.reversals import half_period_s
 from hyst_id.solvers.gaass import GaassSolver
@@ -57,6 +61,7 @@ if TYPE_CHECKING:
 __all__ = [
     'NOISE_FREE_RATIO',
     'UNDER_FLOOR',
+    'artefact_warnings',
     'assess',
     'domain_edge_warnings',
     'explained_share',
@@ -136,7 +141,8 @@ def assess(ident: Identification, rec: Recording,
     """
     if spec is None:
         spec = replace(ident.spec(), calibration=None)
-    out = response_warnings(ident.er_percent, rec.measurement)
+    out = artefact_warnings(rec)
+    out += response_warnings(ident.er_percent, rec.measurement)
     out += orientation_warnings(rec, _sign(ident))
     out += fit_warnings(ident) + floor_estimate_warnings(ident, rec.n_samples)
     out += domain_edge_warnings(ident, rec, spec)
@@ -145,6 +151,13 @@ def assess(ident: Identification, rec: Recording,
     poor = poorly_determined(ident, rec, skip=names)
     out += _poor_warning(poor)
     return out, {name: rel for name, (rel, _) in sorted(poor.items())}
+
+
+def artefact_warnings(rec: Recording) -> list[str]:
+    """The recording's measurement artefacts, one sentence each (the sensor, not the plant)."""
+    return [f'measurement artefact ({a.kind}): {a.words}'
+            for a in find_artefacts(rec.t_s, rec.command, rec.measurement,
+                                    rec.measurement_unit)]
 
 
 def explained_share(er_percent: float, measurement: np.ndarray) -> float:
