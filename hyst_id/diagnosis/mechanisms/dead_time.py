@@ -31,7 +31,10 @@ import numpy as np
 
 from hyst_id.diagnosis.mechanisms.base import Context, Mechanism, Quantity, rate_correlation
 
-__all__ = ['DeadTime', 'MECHANISM']
+__all__ = ['DeadTime', 'MECHANISM', 'MIN_DELAY_SAMPLES']
+
+#: Fewest sample intervals a delay must span to be claimed as a transport delay.
+MIN_DELAY_SAMPLES = 0.8
 
 
 class DeadTime(Mechanism):
@@ -68,6 +71,24 @@ class DeadTime(Mechanism):
         if d <= 0.0:
             return v
         return np.interp(t_s - d, t_s, v)
+
+    def implausible(self, theta, coef, span, noise_std, ctx=None, labels=None) -> str:
+        """A delay under :data:`MIN_DELAY_SAMPLES` of a sample interval is not resolved.
+
+        Interpolated between samples, such a delay averages each command with the
+        one before: a smoothing that soaks up misfit (a sum of plays behind a curved
+        map under a chirp fitted 0.5 samples; a new user's review), not a delay the
+        record shows. True one-sample delays of the reference chain fitted 1.01-1.06
+        samples (4 noise seeds, 0.05 s; ``docs/diagnosis.md``).
+        """
+        if ctx is None or not ctx.dt_s > 0.0:
+            return ''
+        samples = float(theta[0]) / ctx.dt_s
+        if samples < MIN_DELAY_SAMPLES:
+            return (f'a delay of {samples:.2f} sample intervals: under one interval it '
+                    'averages neighbouring commands (a smoothing), not a transport delay '
+                    'the record resolves')
+        return ''
 
     def describe(self, theta, coef, info, ctx) -> dict[str, Quantity]:
         """Delay in seconds and in samples."""
