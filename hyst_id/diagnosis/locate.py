@@ -21,7 +21,8 @@ predicted on the rest) and the measurement-noise level,
 * *is anything left?* whiteness of the residual (autocorrelation with 99 %
   bounds ``2.58/sqrt(N)``, Ljung-Box portmanteau test) and independence from
   the input (cross-correlation with the command and with its rate, with
-  Ljung's bounds ``2.58 sqrt(P/N)``, ``P = sum_k r_ee(k) r_uu(k)``);
+  Ljung's bounds ``3.29 sqrt(P/N)`` (99.9 %: the largest of many lags),
+  ``P = sum_k r_ee(k) r_uu(k)``, at least the white residual's 1);
 * *when?* RMS per time window, the linear trend of the residual (Newey-West
   t statistic) and whether the trend scales with the output level;
 * *under which input?* residual per command level, direction of motion,
@@ -45,7 +46,7 @@ from scipy import stats
 from hyst_id.signals.noise import robust_noise_std as noise_std
 from hyst_id.signals.reversals import reversal_times
 
-__all__ = ['LEVEL_TREND_T', 'Localization', 'locate', 'newey_west_t', 'noise_std']
+__all__ = ['LEVEL_TREND_T', 'Localization', 'locate', 'newey_west_t', 'noise_std', 'span_label']
 
 Z99 = 2.5758   # two-sided 99 % normal quantile
 Z_FAMILY = 3.29  # two-sided 99.9 %: bound for the largest of many correlation lags
@@ -111,7 +112,8 @@ class Localization:
                        'gain that changes with time')
         bad = [w for w in self.windows if w['flagged']]
         if bad:
-            spans = ', '.join(f'{w["t_start_s"]:.0f}-{w["t_end_s"]:.0f} s' for w in bad[:4])
+            spans = ', '.join(f'{span_label(w["t_start_s"], w["t_end_s"], 0)} s'
+                              for w in bad[:4])
             out.append(f'largest in time windows {spans}'
                        + (f' (+{len(bad) - 4} more)' if len(bad) > 4 else ''))
         for key, words, every in (('level', 'at command level', 'command level'),
@@ -200,10 +202,32 @@ def _cross(e, u, n_lag, dt, acf_e):
     lags, r = _ccf(e, u, n_lag)
     acf_u = _acf(u, n_lag)
     p = 1.0 + 2.0 * float(np.sum(acf_e[1:n_lag + 1] * acf_u[1:n_lag + 1]))
-    bound = Z_FAMILY * np.sqrt(max(p, 1e-3) / e.size)
+    # at least the white residual's P = 1: estimated from the sample ACFs the sum over many
+    # lags of a smooth command can come out near 0, and a bound of 0.01 then called r = 0.01
+    # correlated on a clean record (a new user's review: 2,000 samples, bound 0.07)
+    bound = Z_FAMILY * np.sqrt(max(p, 1.0) / e.size)
     k = int(np.argmax(np.abs(r)))
     return {'lags_s': lags * dt, 'r': r, 'bound': float(bound), 'peak_r': float(r[k]),
             'peak_lag_s': float(lags[k] * dt), 'significant': bool(abs(r[k]) > bound)}
+
+
+def span_label(lo: float, hi: float, decimals: int | None = None) -> str:
+    """``lo-hi`` with the digits that tell them apart; ``lo to hi`` when either is negative.
+
+    ``decimals``: fixed decimals to start from (more are added until the two
+    differ: a last window of 19.6-20 s had read '20-20 s'); else 4 significant
+    digits, more as needed (a level range '-0.9998--0.5968' now reads
+    '-0.9998 to -0.5968').
+    """
+    lo, hi = float(lo), float(hi)
+    for extra in range(0, 6):
+        if decimals is None:
+            a, b = f'{lo:.{4 + extra}g}', f'{hi:.{4 + extra}g}'
+        else:
+            a, b = f'{lo:.{decimals + extra}f}', f'{hi:.{decimals + extra}f}'
+        if a != b or lo == hi:
+            break
+    return f'{a} to {b}' if lo < 0 or hi < 0 else f'{a}-{b}'
 
 
 def _bin(label, sel, e, sigma, bw, lo=None, hi=None):
@@ -309,7 +333,7 @@ def locate(t_s: np.ndarray, command: np.ndarray, measurement: np.ndarray,
     qs = np.percentile(v, [0, 20, 40, 60, 80, 100])
     for i in range(5):
         sel = (v >= qs[i]) & ((v < qs[i + 1]) if i < 4 else (v <= qs[i + 1]))
-        b = _bin(f'{qs[i]:.4g}-{qs[i + 1]:.4g}', sel, e, sigma, bw, float(qs[i]),
+        b = _bin(span_label(qs[i], qs[i + 1]), sel, e, sigma, bw, float(qs[i]),
                  float(qs[i + 1]))
         if b:
             regimes['level'].append(b)
