@@ -25,10 +25,15 @@ import numpy as np
 
 from hyst_id.io.numbers import level
 
-__all__ = ['BARELY', 'LINE_PARAMS', 'active_lines', 'unexcited_lines']
+__all__ = ['BARELY', 'FAR_SPANS', 'LINE_PARAMS', 'active_lines', 'unexcited_lines']
 
 #: A line followed over less than this fraction of the command span is barely excited.
 BARELY = 0.02
+
+#: A corner more than this many command spans (and this many times the largest command)
+#: beyond the commands is not a level to drive to: the fit has placed the line anywhere (a
+#: new user's dropout record: the top-right corner at 744942 for commands within +-1).
+FAR_SPANS = 10.0
 
 #: Parameters each line of the loop determines.
 LINE_PARAMS = {'left': ('m_l', 'c_l'), 'right': ('m_r', 'c_r'), 'top': ('m_t', 'c_t'),
@@ -150,8 +155,15 @@ def unexcited_lines(params: np.ndarray, command: np.ndarray, u: np.ndarray,
                 f'{"is" if len(undetermined) == 1 else "are"} not identifiable from this '
                 'recording')
         short = (extreme < v_corner) if verb == 'rises' else (extreme > v_corner)
-        if short:
-            vspan = float(np.ptp(v))
+        vspan = float(np.ptp(v))
+        far = FAR_SPANS * max(vspan, float(np.max(np.abs(v))))
+        if short and abs(v_corner - extreme) > far:
+            out.append(f'the {line} line of the loop is never reached: the fit puts the '
+                       f'{corner} at {level(v_corner, vspan)}{unit}, far beyond any command '
+                       f'recorded ({abs(v_corner - extreme) / vspan:.0f} command spans past '
+                       f'{level(extreme, vspan)}{unit}): the recording does not say where it '
+                       f'is, and it is no level to drive to; {what}')
+        elif short:
             out.append(f'the {line} line of the loop is never reached: the command {verb} '
                        f'to {level(extreme, vspan)}{unit} but the {corner} of the loop is at '
                        f'{level(v_corner, vspan)}{unit}; {what} (drive the command {side} '

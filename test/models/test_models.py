@@ -215,3 +215,27 @@ def test_canonical_gauge_leaves_the_output_unchanged(channel):
     canon = canonical_gauge(raw, (2.5, -40.0))
     assert canon[8] == 1.0 and canon[9] == pytest.approx(-canon[10])
     np.testing.assert_allclose(spec.simulate(canon, t, v, (1.0, 0.0)), y, atol=1e-9)
+
+
+def test_a_corner_far_beyond_the_commands_is_not_a_level_to_drive_to():
+    """A dropout record's fit put the top-right corner at 744942 for commands within +-1.
+
+    The warning had said 'drive the command above 744942.6327'; a corner more than
+    ten command spans and ten times the largest command away says the recording does
+    not place it. A corner within reach keeps the advice.
+    """
+    from hyst_id.models.registry import FAMILIES
+    from hyst_id.models.tk import loop_corners
+    from hyst_id.models.tk_lines import unexcited_lines
+
+    p = np.array([1.01, 1.05, 0.10, 0.15, -0.25, 0.50, 14.0, 7.0])
+    t = np.arange(0.0, 60.0, 0.05)
+    v = 9.0 + 0.9 * np.sin(2 * np.pi * t / 10.0)
+    u = FAMILIES['tk'].simulate(p, v)
+    corners = loop_corners(p)
+    near = unexcited_lines(p, v, u, corners)[0]
+    assert any('drive the command above 15.289' in w for w in near), near
+    far = dict(corners, C=(744942.6327, corners['C'][1]))
+    words = [w for w in unexcited_lines(p, v, u, far)[0] if w.startswith('the top line')]
+    assert len(words) == 1 and 'no level to drive to' in words[0], words
+    assert 'drive the command' not in words[0]
