@@ -1,0 +1,123 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""Measurement artefacts on random families of the reference chain: what is named, what missed.
+
+The draws of ``test/signals/test_artefacts.py`` (the reference chain of
+``test/reference_sim`` over three channels, five excitations, 0.005-0.05 s and
+0.1-1 % noise), each read by :func:`hyst_id.signals.artefacts.find_artefacts`:
+clean, noise-free (the same commands, no noise), with a dropout of 1-8 % of the
+record, and with single-sample spikes of 12-40 noise stds (at least 5 % of the
+span). The test checks the first fifteen draws; its thresholds come from the
+figures this prints. A few seconds for 300 draws.
+
+Usage (from the repository root)::
+
+    python bench/artefact_family.py [--draws 300]
+"""
+
+from __future__ import annotations
+
+import argparse
+from collections import Counter
+from pathlib import Path
+import sys
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / 'test'))
+sys.path.insert(0, str(ROOT / 'test' / 'signals'))
+
+from reference_sim import simulate  # noqa: E402,I100
+from test_artefacts import _draw, TRUTH  # noqa: E402
+
+from hyst_id.io.recording import Recording  # noqa: E402
+from hyst_id.signals.artefacts import find_artefacts  # noqa: E402
+
+
+def dropout(index: int) -> str | None:
+    """Outcome of draw ``index`` with a dropout; None when the command rests over it."""
+    rec, _ = _draw(index)
+    rng = np.random.default_rng([index, 32])
+    n = rec.n_samples
+    length = int(rng.uniform(0.01, 0.08) * n)
+    first = int(rng.integers(n // 10, n - length - n // 10))
+    y = rec.measurement.copy()
+    y[first:first + length] = y[first - 1]
+    if np.ptp(rec.command[first - 1:first + length]) <= 0.02 * np.ptp(rec.command):
+        return None
+    found = find_artefacts(rec.t_s, rec.command, y)
+    kinds = [a.kind for a in found]
+    exact = any(a.samples == ((first - 1, length + 1),) for a in found)
+    if kinds == ['frozen'] and exact:
+        return 'frozen, exact samples'
+    if kinds == ['clipped'] and exact:
+        return "clipped (the held value is the record's extreme), exact samples"
+    if not kinds:
+        return 'missed'
+    return 'named with more: ' + '+'.join(kinds)
+
+
+def spikes(index: int) -> tuple[int, int, int]:
+    """Spikes written, spikes found, other samples named, for draw ``index``."""
+    rec, sigma = _draw(index)
+    rng = np.random.default_rng([index, 33])
+    y = rec.measurement.copy()
+    at = np.sort(rng.choice(np.arange(5, rec.n_samples - 5), int(rng.integers(3, 9)),
+                            replace=False))
+    at = at[np.diff(np.r_[-10, at]) > 3]
+    size = np.maximum(rng.uniform(12.0, 40.0, at.size) * sigma, 0.05 * np.ptp(y))
+    y[at] += rng.choice([-1.0, 1.0], at.size) * size
+    named = {i for a in find_artefacts(rec.t_s, rec.command, y) for i, _ in a.samples}
+    return at.size, len(named & set(at.tolist())), len(named - set(at.tolist()))
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument('--draws', type=int, default=300)
+    args = ap.parse_args(argv)
+    clean, noise_free, drops = Counter(), Counter(), Counter()
+    written = found = others = 0
+    shares = []
+    for index in range(args.draws):
+        rec, _ = _draw(index)
+        clean[tuple(a.kind for a in find_artefacts(rec.t_s, rec.command, rec.measurement))] += 1
+        for ch in ('position', 'pressure', 'flow'):
+            x = simulate(ch, TRUTH, rec.t_s, rec.command)
+            noise_free[tuple(a.kind for a in find_artefacts(
+                rec.t_s, rec.command, Recording(rec.t_s, rec.command, x, ch).measurement))] += 1
+        outcome = dropout(index)
+        if outcome is not None:
+            drops[outcome] += 1
+        w, f, o = spikes(index)
+        written, found, others = written + w, found + f, others + o
+        shares.append(f / w)
+    print(f'{args.draws} draws')
+    print('clean, kinds named:', {k or 'none': v for k, v in clean.items()})
+    print('noise-free twins (3 channels each), kinds named:',
+          {k or 'none': v for k, v in noise_free.items()})
+    print(f'dropouts while the command moves: {sum(drops.values())}')
+    for outcome, count in drops.most_common():
+        print(f'  {count:4d}  {outcome}')
+    s = np.array(shares)
+    print(f'spikes: {found}/{written} found ({100.0 * found / written:.0f} %), other samples '
+          f'named {others}; per draw: 5th percentile {100.0 * np.quantile(s, 0.05):.0f} %, '
+          f'median {100.0 * np.median(s):.0f} %, draws with none found {int(np.sum(s == 0))}')
+    return 0
+
+
+if __name__ == '__main__':
+    raise SystemExit(main())
