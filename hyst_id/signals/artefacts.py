@@ -41,9 +41,11 @@ four things no actuator or sensor model explains, each named as such
   levels over its span where the step sets the noise floor (the noise std at
   most 1.5 x the step's ``q/sqrt(12)``), or at most a quarter of them
   whatever the noise: a coarse A/D.
-* ``irregular_sampling`` -- the intervals between stamps (gaps of more than
-  five median intervals aside: they are noted as gaps) vary with a
-  coefficient of variation above :data:`JITTER_CV`.
+* ``irregular_sampling`` -- the intervals between stamps (those longer than
+  five median intervals left out: gaps, which the reader notes from ten) vary
+  with a coefficient of variation above :data:`JITTER_CV`; said as the stamps'
+  resolution when they are rounded to a step (intervals of 3 and 4 ms about a
+  3.33 ms sampling), else as jitter.
 
 The rules judge repeats to round-off and take no sum whose last bits decide
 an answer.
@@ -56,6 +58,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from hyst_id.signals.noise import quantum, REPEAT_TOLERANCE, robust_noise_std
+from hyst_id.signals.reversals import reversal_indices
 
 __all__ = ['Artefact', 'COARSE_LEVELS', 'find_artefacts', 'FROZEN_MIN_SAMPLES', 'GLITCH_FACTOR',
            'GLITCH_SHAPE', 'GLITCH_SPAN', 'JITTER_CV', 'NOISY_SHARE']
@@ -151,8 +154,9 @@ def find_artefacts(t_s: np.ndarray, command: np.ndarray, measurement: np.ndarray
         return []
     q = quantum(y)
     sigma = robust_noise_std(y)
-    out = _frozen(t, v, y, span, sigma, q, unit)
-    out += _glitches(t, v, y, sigma, q, unit)
+    near_turn, reversals = _command_turns(v)
+    out = _frozen(t, v, y, span, sigma, q, unit, reversals)
+    out += _glitches(t, y, sigma, q, unit, near_turn)
     q_std = q / np.sqrt(12.0)
     coarse = q > 0.0 and (round(span / q) + 1 <= COARSE_LEVELS // 4
                           or (round(span / q) + 1 <= COARSE_LEVELS and sigma <= 1.5 * q_std))
@@ -169,7 +173,8 @@ def find_artefacts(t_s: np.ndarray, command: np.ndarray, measurement: np.ndarray
     return out
 
 
-def _frozen(t, v, y, span, sigma, q, unit) -> list[Artefact]:
+def _frozen(t: np.ndarray, v: np.ndarray, y: np.ndarray, span: float, sigma: float, q: float,
+            unit: str, reversals: np.ndarray) -> list[Artefact]:
     if q > 0.0 or not sigma >= NOISY_SHARE * span:
         return []
     tol = REPEAT_TOLERANCE * float(np.max(np.abs(y)))
@@ -177,10 +182,14 @@ def _frozen(t, v, y, span, sigma, q, unit) -> list[Artefact]:
     v_span = float(np.ptp(v))
     typical = float(np.median(np.abs(np.diff(y))))
     found: dict[str, list[tuple[int, int]]] = {'frozen': [], 'clipped': []}
-    for first, count in _runs(rep):
+    runs = [r for r in _runs(rep) if r[1] >= 1]
+    physics = _holds_at_reversals(np.array([r[0] for r in runs], dtype=int), reversals)
+    for (first, count), held in zip(runs, physics):
         n = count + 1                               # samples in a run of ``count`` repeats
         if n < FROZEN_MIN_SAMPLES or not np.ptp(v[first:first + n]) > COMMAND_MOVES * v_span:
             continue
+        if held:
+            continue    # a noise-free plant holds still in its play after each reversal
         end = first + n - 1
         smooth_in = first == 0 or abs(y[first] - y[first - 1]) < ENTRY_STEPS * typical
         smooth_out = end + 1 < y.size and abs(y[end + 1] - y[end]) < EXIT_STEPS * typical
@@ -209,7 +218,8 @@ def _frozen(t, v, y, span, sigma, q, unit) -> list[Artefact]:
     return out
 
 
-def _glitches(t, v, y, sigma, q, unit) -> list[Artefact]:
+def _glitches(t: np.ndarray, y: np.ndarray, sigma: float, q: float, unit: str,
+              turns: np.ndarray) -> list[Artefact]:
     scale = max(sigma, q)
     if not scale > 0.0:
         return []
@@ -225,13 +235,19 @@ def _glitches(t, v, y, sigma, q, unit) -> list[Artefact]:
     least = max(GLITCH_FACTOR * scale, GLITCH_SPAN * float(np.ptp(y)))
     spike = (np.abs(dev) > least) & (line > least) & (line > GLITCH_SHAPE * shape) & same_side
     idx = np.flatnonzero(spike) + 2
-    # a spike leaves its neighbours' cubic off by 2/3 of it: keep the largest within two
-    idx = np.array([i for i in idx if abs(dev[i - 2]) >= np.max(np.abs(
-        dev[max(i - 4, 0):i + 1]))], dtype=int)
+    # a spike leaves its neighbours' cubic off by 2/3 of it: keep the largest within two;
+    # and it stands alone: ringing that the cubic cannot follow (a lightly damped mode at
+    # a few samples per period) repeats it three to six samples away
+    mag = np.abs(dev)
+
+    def alone(i: int) -> bool:
+        near = mag[max(i - 4, 0):i + 1]
+        far = np.r_[mag[max(i - 8, 0):max(i - 4, 0)], mag[i + 1:i + 5]]
+        return mag[i - 2] >= np.max(near) and not (far.size and np.max(far) >= 0.5 * least)
+    idx = np.array([i for i in idx if alone(int(i))], dtype=int)
     if not idx.size:
         return []
-    guard = _command_turns(v)
-    idx = idx[~guard[idx]]
+    idx = idx[~turns[idx]]
     if not idx.size:
         return []
     size = np.abs(dev[idx - 2])
@@ -244,24 +260,38 @@ def _glitches(t, v, y, sigma, q, unit) -> list[Artefact]:
         'errors: remove or replace those samples before trusting the fit'))]
 
 
-def _command_turns(v: np.ndarray) -> np.ndarray:
-    """Samples within :data:`GLITCH_GUARD` of a command reversal or jump."""
-    d = np.diff(v)
-    step = np.abs(d)
-    typical = float(np.median(step))        # 0 where the command mostly holds: steps
+def _command_turns(v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Samples within :data:`GLITCH_GUARD` of a command reversal or jump; the reversals.
+
+    Reversals are judged with a band of three noise stds of the command (a measured,
+    noisy command turned at every sample and left nothing to judge); a jump is a
+    step above five median steps (any step where the command mostly holds).
+    """
     turn = np.zeros(v.size, dtype=bool)
-    s = np.sign(d)
-    s_nz = s.copy()
-    for k in range(1, s_nz.size):            # a pause keeps the last direction
-        if s_nz[k] == 0:
-            s_nz[k] = s_nz[k - 1]
-    turn[1:-1] |= s_nz[1:] * s_nz[:-1] < 0
-    turn[1:] |= step > 5.0 * typical
-    out = turn.copy()
+    idx, _ = reversal_indices(v, tolerance=3.0 * robust_noise_std(v))
+    turn[idx] = True
+    step = np.abs(np.diff(v))
+    turn[1:] |= step > 5.0 * float(np.median(step))
+    near = turn.copy()
     for k in range(1, GLITCH_GUARD + 1):
-        out[k:] |= turn[:-k]
-        out[:-k] |= turn[k:]
-    return out
+        near[k:] |= turn[:-k]
+        near[:-k] |= turn[k:]
+    return near, idx
+
+
+def _holds_at_reversals(starts: np.ndarray, reversals: np.ndarray) -> np.ndarray:
+    """Whether each run start is within :data:`GLITCH_GUARD` samples after a reversal.
+
+    All False unless at least half the reversals (two or more) are followed so:
+    a noise-free plant then holds exactly still in its play after every turn
+    (physics); a noisy reading does not, and a dropout there is still one.
+    """
+    if reversals.size < 2 or not starts.size:
+        return np.zeros(starts.size, dtype=bool)
+    k = np.searchsorted(reversals, starts, side='right') - 1
+    after = (k >= 0) & (starts - reversals[np.maximum(k, 0)] <= GLITCH_GUARD)
+    followed = np.unique(k[after]).size
+    return after if followed >= 0.5 * reversals.size else np.zeros(starts.size, dtype=bool)
 
 
 def _jitter(t: np.ndarray) -> list[Artefact]:
@@ -275,12 +305,38 @@ def _jitter(t: np.ndarray) -> list[Artefact]:
     cv = float(np.std(regular) / np.mean(regular))
     if cv <= JITTER_CV:
         return []
+    step = _stamp_step(t, regular, med)
+    if step:                          # rounded stamps: a few interval values a step apart
+        values = ', '.join(_g(1e3 * x) for x in np.unique(np.round(regular / step)) * step)
+        return [Artefact('irregular_sampling', (), (
+            f'the stamps are rounded to {_g(1e3 * step)} ms: the intervals take the values '
+            f'{values} ms about a median of {_g(1e3 * med)} ms (coefficient of variation '
+            f'{100.0 * cv:.0f} %), a timing error of up to half a step in each stamp, not '
+            'jitter of the sampling; finer stamps remove it'))]
     return [Artefact('irregular_sampling', (), (
         f'the sampling interval varies from {_g(1e3 * float(np.min(regular)))} to '
         f'{_g(1e3 * float(np.max(regular)))} ms (median {_g(1e3 * med)} ms, coefficient of '
         f'variation {100.0 * cv:.0f} %): the models run on the stamps, so this is fitted as '
         'recorded; if the stamps are arrival times rather than sampling times, their jitter '
         'is error the fit cannot remove (stamp at the source)'))]
+
+
+def _stamp_step(t: np.ndarray, regular: np.ndarray, med: float) -> float:
+    """The stamps' resolution when they are rounded to it (0 when not).
+
+    Rounded: the intervals take at most four values, consecutive multiples of
+    one step, and every stamp lies on that step's grid (to 1e-3 of it).
+    """
+    keys, which = np.unique(np.round(regular / med, 6), return_inverse=True)
+    if not 2 <= keys.size <= 4:
+        return 0.0
+    values = np.array([float(np.mean(regular[which == j])) for j in range(keys.size)])
+    steps = np.diff(values)
+    step = float(np.min(steps))
+    if not step > 0.0 or np.max(np.abs(steps / step - np.round(steps / step))) > 1e-3:
+        return 0.0
+    k = (t - t[0]) / step
+    return step if float(np.max(np.abs(k - np.round(k)))) < 1e-3 else 0.0
 
 
 def _runs(flags: np.ndarray) -> list[tuple[int, int]]:

@@ -49,7 +49,10 @@ def test_the_rule_reads_the_delay_in_sample_intervals():
     m = get_mechanisms(('dead_time',), channel='position')[0]
     ctx = Context('position', np.arange(0.0, 10.0, DT_S), 140)
     assert 'sample intervals' in m.implausible(np.array([0.5 * DT_S]), None, (0, 1), 0.1, ctx)
-    assert m.implausible(np.array([MIN_DELAY_SAMPLES * DT_S]), None, (0, 1), 0.1, ctx) == ''
+    # either side of the rule, not on it (the median interval carries round-off)
+    assert 'sample intervals' in m.implausible(np.array([0.7 * DT_S]), None, (0, 1), 0.1, ctx)
+    assert m.implausible(np.array([0.9 * DT_S]), None, (0, 1), 0.1, ctx) == ''
+    assert MIN_DELAY_SAMPLES == 0.8
     assert m.implausible(np.array([3.0 * DT_S]), None, (0, 1), 0.1, ctx) == ''
 
 
