@@ -42,7 +42,7 @@ sys.path.insert(0, str(ROOT / 'test'))
 sys.path.insert(0, str(ROOT / 'test' / 'signals'))
 
 from reference_sim import simulate  # noqa: E402,I100
-from test_artefacts import _draw, TRUTH  # noqa: E402
+from test_artefacts import _draw, TRUTH, with_dropout, with_spikes  # noqa: E402
 
 from hyst_id.io.recording import Recording  # noqa: E402
 from hyst_id.signals.artefacts import find_artefacts  # noqa: E402
@@ -50,13 +50,7 @@ from hyst_id.signals.artefacts import find_artefacts  # noqa: E402
 
 def dropout(index: int) -> str | None:
     """Outcome of draw ``index`` with a dropout; None when the command rests over it."""
-    rec, _ = _draw(index)
-    rng = np.random.default_rng([index, 32])
-    n = rec.n_samples
-    length = int(rng.uniform(0.01, 0.08) * n)
-    first = int(rng.integers(n // 10, n - length - n // 10))
-    y = rec.measurement.copy()
-    y[first:first + length] = y[first - 1]
+    rec, y, first, length = with_dropout(index)
     if np.ptp(rec.command[first - 1:first + length]) <= 0.02 * np.ptp(rec.command):
         return None
     found = find_artefacts(rec.t_s, rec.command, y)
@@ -73,14 +67,7 @@ def dropout(index: int) -> str | None:
 
 def spikes(index: int) -> tuple[int, int, int]:
     """Spikes written, spikes found, other samples named, for draw ``index``."""
-    rec, sigma = _draw(index)
-    rng = np.random.default_rng([index, 33])
-    y = rec.measurement.copy()
-    at = np.sort(rng.choice(np.arange(5, rec.n_samples - 5), int(rng.integers(3, 9)),
-                            replace=False))
-    at = at[np.diff(np.r_[-10, at]) > 3]
-    size = np.maximum(rng.uniform(12.0, 40.0, at.size) * sigma, 0.05 * np.ptp(y))
-    y[at] += rng.choice([-1.0, 1.0], at.size) * size
+    rec, y, at = with_spikes(index)
     named = {i for a in find_artefacts(rec.t_s, rec.command, y) for i, _ in a.samples}
     return at.size, len(named & set(at.tolist())), len(named - set(at.tolist()))
 

@@ -77,6 +77,31 @@ def _draw(index: int, channel: str | None = None) -> tuple[Recording, float]:
     return Recording(t, v, x + rng.normal(0.0, sigma, n), channel), float(sigma)
 
 
+def with_dropout(index: int) -> tuple[Recording, np.ndarray, int, int]:
+    """Draw ``index`` with a dropout of 1-8 %: the draw, its reading, first held, length."""
+    rec = draw(index)
+    rng = np.random.default_rng([index, 32])
+    n = rec.n_samples
+    length = int(rng.uniform(0.01, 0.08) * n)
+    first = int(rng.integers(n // 10, n - length - n // 10))
+    y = rec.measurement.copy()
+    y[first:first + length] = y[first - 1]
+    return rec, y, first, length
+
+
+def with_spikes(index: int) -> tuple[Recording, np.ndarray, np.ndarray]:
+    """Draw ``index`` with 3-8 single-sample spikes: the draw, its reading, their samples."""
+    rec, sigma = _draw(index)
+    rng = np.random.default_rng([index, 33])
+    y = rec.measurement.copy()
+    at = np.sort(rng.choice(np.arange(5, rec.n_samples - 5), int(rng.integers(3, 9)),
+                            replace=False))
+    at = at[np.diff(np.r_[-10, at]) > 3]                     # single samples, apart
+    size = np.maximum(rng.uniform(12.0, 40.0, at.size) * sigma, 0.05 * np.ptp(y))
+    y[at] += rng.choice([-1.0, 1.0], at.size) * size
+    return rec, y, at
+
+
 def kinds(rec: Recording) -> list[str]:
     return [a.kind for a in find_artefacts(rec.t_s, rec.command, rec.measurement)]
 
@@ -98,13 +123,7 @@ def test_a_noise_free_simulation_holding_still_is_not_frozen(channel):
 @pytest.mark.parametrize('index', DRAWS)
 def test_a_stretch_that_holds_its_last_value_is_frozen(index):
     """A dropout of 1-8 % of the record, anywhere inside it: named, with where it is."""
-    rec = draw(index)
-    rng = np.random.default_rng([index, 32])
-    n = rec.n_samples
-    length = int(rng.uniform(0.01, 0.08) * n)
-    first = int(rng.integers(n // 10, n - length - n // 10))
-    y = rec.measurement.copy()
-    y[first:first + length] = y[first - 1]
+    rec, y, first, length = with_dropout(index)
     if np.ptp(rec.command[first - 1:first + length]) <= 0.02 * np.ptp(rec.command):
         pytest.skip('the command rests over this stretch: a held reading is then no artefact')
     found = find_artefacts(rec.t_s, rec.command, y)
@@ -138,14 +157,7 @@ def test_single_sample_spikes_are_glitches():
     """
     found_all, spikes = 0, 0
     for index in DRAWS:
-        rec, sigma = _draw(index)
-        rng = np.random.default_rng([index, 33])
-        y = rec.measurement.copy()
-        at = np.sort(rng.choice(np.arange(5, rec.n_samples - 5), int(rng.integers(3, 9)),
-                                replace=False))
-        at = at[np.diff(np.r_[-10, at]) > 3]                 # single samples, apart
-        size = np.maximum(rng.uniform(12.0, 40.0, at.size) * sigma, 0.05 * np.ptp(y))
-        y[at] += rng.choice([-1.0, 1.0], at.size) * size
+        rec, y, at = with_spikes(index)
         found = find_artefacts(rec.t_s, rec.command, y)
         assert {a.kind for a in found} <= {'glitch'}, (index, [a.words for a in found])
         named = {i for a in found for i, _ in a.samples}
