@@ -24,7 +24,11 @@ figures this prints. A few seconds for 300 draws.
 
 Usage (from the repository root)::
 
-    python bench/artefact_family.py [--draws 300]
+    python bench/artefact_family.py [--draws 300] [--probe K]
+
+``--probe K`` multiplies every command and reading by ``1 + 1e-12 z`` (``z``
+standard normal, seeded by ``K``) before reading it: another CPU's last bits.
+The figures should not move.
 """
 
 from __future__ import annotations
@@ -48,12 +52,25 @@ from hyst_id.io.recording import Recording  # noqa: E402
 from hyst_id.signals.artefacts import find_artefacts  # noqa: E402
 
 
+#: Seed of the round-off probe (``--probe``); None: the values as drawn.
+PROBE: list[int | None] = [None]
+
+
+def _find(t: np.ndarray, v: np.ndarray, y: np.ndarray) -> list:
+    """:func:`find_artefacts`, on values moved in their last bits under ``--probe``."""
+    if PROBE[0] is not None:
+        rng = np.random.default_rng([PROBE[0], v.size])
+        v = v * (1.0 + 1e-12 * rng.standard_normal(v.size))
+        y = y * (1.0 + 1e-12 * rng.standard_normal(y.size))
+    return find_artefacts(t, v, y)
+
+
 def dropout(index: int) -> str | None:
     """Outcome of draw ``index`` with a dropout; None when the command rests over it."""
     rec, y, first, length = with_dropout(index)
     if np.ptp(rec.command[first - 1:first + length]) <= 0.02 * np.ptp(rec.command):
         return None
-    found = find_artefacts(rec.t_s, rec.command, y)
+    found = _find(rec.t_s, rec.command, y)
     kinds = [a.kind for a in found]
     exact = any(a.samples == ((first - 1, length + 1),) for a in found)
     if kinds == ['frozen'] and exact:
@@ -68,23 +85,26 @@ def dropout(index: int) -> str | None:
 def spikes(index: int) -> tuple[int, int, int]:
     """Spikes written, spikes found, other samples named, for draw ``index``."""
     rec, y, at = with_spikes(index)
-    named = {i for a in find_artefacts(rec.t_s, rec.command, y) for i, _ in a.samples}
+    named = {i for a in _find(rec.t_s, rec.command, y) for i, _ in a.samples}
     return at.size, len(named & set(at.tolist())), len(named - set(at.tolist()))
 
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument('--draws', type=int, default=300)
+    ap.add_argument('--probe', type=int, default=None, metavar='K',
+                    help='move every value in its last bits (seed K) before reading it')
     args = ap.parse_args(argv)
+    PROBE[0] = args.probe
     clean, noise_free, drops = Counter(), Counter(), Counter()
     written = found = others = 0
     shares = []
     for index in range(args.draws):
         rec, _ = _draw(index)
-        clean[tuple(a.kind for a in find_artefacts(rec.t_s, rec.command, rec.measurement))] += 1
+        clean[tuple(a.kind for a in _find(rec.t_s, rec.command, rec.measurement))] += 1
         for ch in ('position', 'pressure', 'flow'):
             x = simulate(ch, TRUTH, rec.t_s, rec.command)
-            noise_free[tuple(a.kind for a in find_artefacts(
+            noise_free[tuple(a.kind for a in _find(
                 rec.t_s, rec.command, Recording(rec.t_s, rec.command, x, ch).measurement))] += 1
         outcome = dropout(index)
         if outcome is not None:
@@ -92,7 +112,8 @@ def main(argv: list[str] | None = None) -> int:
         w, f, o = spikes(index)
         written, found, others = written + w, found + f, others + o
         shares.append(f / w)
-    print(f'{args.draws} draws')
+    probe = '' if args.probe is None else f', round-off probe {args.probe}'
+    print(f'{args.draws} draws{probe}')
     print('clean, kinds named:', {k or 'none': v for k, v in clean.items()})
     print('noise-free twins (3 channels each), kinds named:',
           {k or 'none': v for k, v in noise_free.items()})

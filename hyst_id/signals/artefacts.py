@@ -265,18 +265,34 @@ def _command_turns(v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
     Reversals are judged with a band of three noise stds of the command (a measured,
     noisy command turned at every sample and left nothing to judge); a jump is a
-    step above five median steps (any step where the command mostly holds).
+    step above five median steps (any step where the command mostly holds). Both
+    bands are at least the round-off of the command's values
+    (:data:`~hyst_id.signals.noise.REPEAT_TOLERANCE`): a held command moved in its
+    last bits had turned at every sample.
     """
     turn = np.zeros(v.size, dtype=bool)
-    idx, _ = reversal_indices(v, tolerance=3.0 * robust_noise_std(v))
+    roundoff = REPEAT_TOLERANCE * float(np.max(np.abs(v)))   # last bits are no move
+    idx, _ = reversal_indices(v, tolerance=max(3.0 * robust_noise_std(v), roundoff))
+    idx = np.array([_plateau_start(v, int(k), roundoff) for k in idx], dtype=int)
     turn[idx] = True
     step = np.abs(np.diff(v))
-    turn[1:] |= step > 5.0 * float(np.median(step))
+    turn[1:] |= step > 5.0 * max(float(np.median(step)), roundoff)
     near = turn.copy()
     for k in range(1, GLITCH_GUARD + 1):
         near[k:] |= turn[:-k]
         near[:-k] |= turn[k:]
     return near, idx
+
+
+def _plateau_start(v: np.ndarray, k: int, roundoff: float) -> int:
+    """First sample of the plateau the extremum ``k`` lies on (to round-off).
+
+    The extremum of a held command is any sample of the hold, whichever the last
+    bits make largest; its first sample is the same on every machine.
+    """
+    while k > 0 and abs(v[k - 1] - v[k]) <= roundoff:
+        k -= 1
+    return k
 
 
 def _holds_at_reversals(starts: np.ndarray, reversals: np.ndarray) -> np.ndarray:
