@@ -32,6 +32,7 @@ from hyst_id.identification.result import IdentifySettings
 from hyst_id.io.params_file import read_yaml
 from hyst_id.io.recording import Recording
 from hyst_id.models.registry import DEFAULT_FAMILY, get_family
+from hyst_id.solvers.gaass import check_rates
 
 __all__ = ['check_domains_file', 'make_settings', 'make_spec', 'MAX_GENERATIONS', 'MAX_HOPS',
            'MAX_POP_SIZE', 'MAX_SEEDS', 'read_domains_file']
@@ -65,10 +66,7 @@ def make_settings(*, seeds: int = 10, seed_offset: int = 0, pop_size: int = 10,
         a contraction rate ``c`` that is not a finite number > 0 or a ``xi`` outside
         (0, 1] (checked here as GAASS checks them, before any work is printed or done).
     """
-    if not (math.isfinite(c) and c > 0.0):
-        raise ConfigError(f'the contraction rate c (--c) must be a finite number > 0, got {c}')
-    if not (math.isfinite(xi) and 0.0 < xi <= 1.0):
-        raise ConfigError(f'xi (--xi) must be in (0, 1], got {xi}')
+    check_rates(c, xi, ('the contraction rate c (--c)', 'xi (--xi)'))
     if seeds < 1 or pop_size < 2 or generations < 1 or restarts < 0 or global_evals < 0 \
             or global_runs < 0 or hops < 0 or search_samples < 0:
         raise ConfigError('need seeds >= 1, pop size >= 2, generations >= 1, restarts >= 0, '

@@ -39,6 +39,7 @@ __all__ = [
     'GaassHistory',
     'GaassResult',
     'GaassSolver',
+    'check_rates',
     'minimize',
     'parse_bounds',
     'vectorize_scalar',
@@ -177,6 +178,22 @@ def parse_bounds(bounds: Any) -> tuple[np.ndarray, np.ndarray]:
     return low.astype(float).copy(), high.astype(float).copy()
 
 
+def check_rates(c: float, xi: float, names: tuple[str, str] = ('c', 'xi')) -> None:
+    """Refuse a contraction rate ``c`` that is not a finite number > 0, a ``xi`` outside (0, 1].
+
+    ``names`` say them as the caller's user knows them (the CLI's flags).
+
+    Raises
+    ------
+    ConfigError
+        Either value out of its range.
+    """
+    if not (np.isfinite(c) and c > 0.0):
+        raise ConfigError(f'{names[0]} must be a finite number > 0, got {c!r}')
+    if not (np.isfinite(xi) and 0.0 < xi <= 1.0):
+        raise ConfigError(f'{names[1]} must be in (0, 1], got {xi!r}')
+
+
 def _pair(value: Sequence[float], name: str) -> tuple[float, float]:
     try:
         low, high = (float(v) for v in value)
@@ -249,10 +266,7 @@ class GaassSolver:
         if int(max_reject_tries) != max_reject_tries or max_reject_tries < 1:
             raise ConfigError('max_reject_tries must be an integer >= 1, '
                               f'got {max_reject_tries!r}')
-        if not (np.isfinite(c) and c > 0.0):
-            raise ConfigError(f'c must be a positive number, got {c!r}')
-        if not (np.isfinite(xi) and 0.0 < xi <= 1.0):
-            raise ConfigError(f'xi must be in (0, 1], got {xi!r}')
+        check_rates(c, xi)
         if fitness not in ops.FITNESS_TRANSFORMS:
             raise ConfigError(f'fitness must be one of {ops.FITNESS_TRANSFORMS}, got {fitness!r}')
         if target is not None and not np.isfinite(target):
