@@ -57,7 +57,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from hyst_id.signals.noise import quantum, REPEAT_TOLERANCE, robust_noise_std
+from hyst_id.signals.noise import quantum, repeat_tolerance, robust_noise_std
 from hyst_id.signals.reversals import reversal_indices
 
 __all__ = ['Artefact', 'COARSE_LEVELS', 'find_artefacts', 'FROZEN_MIN_SAMPLES', 'GLITCH_FACTOR',
@@ -177,7 +177,7 @@ def _frozen(t: np.ndarray, v: np.ndarray, y: np.ndarray, span: float, sigma: flo
             unit: str, reversals: np.ndarray) -> list[Artefact]:
     if q > 0.0 or not sigma >= NOISY_SHARE * span:
         return []
-    tol = REPEAT_TOLERANCE * float(np.max(np.abs(y)))
+    tol = repeat_tolerance(y)
     rep = np.abs(np.diff(y)) <= tol
     v_span = float(np.ptp(v))
     typical = float(np.median(np.abs(np.diff(y))))
@@ -267,11 +267,11 @@ def _command_turns(v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     noisy command turned at every sample and left nothing to judge); a jump is a
     step above five median steps (any step where the command mostly holds). Both
     bands are at least the round-off of the command's values
-    (:data:`~hyst_id.signals.noise.REPEAT_TOLERANCE`): a held command moved in its
+    (:func:`~hyst_id.signals.noise.repeat_tolerance`): a held command moved in its
     last bits had turned at every sample.
     """
     turn = np.zeros(v.size, dtype=bool)
-    roundoff = REPEAT_TOLERANCE * float(np.max(np.abs(v)))   # last bits are no move
+    roundoff = repeat_tolerance(v)            # last bits are no move
     idx, _ = reversal_indices(v, tolerance=max(3.0 * robust_noise_std(v), roundoff))
     idx = np.array([_plateau_start(v, int(k), roundoff) for k in idx], dtype=int)
     turn[idx] = True

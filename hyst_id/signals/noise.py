@@ -42,7 +42,7 @@ from math import comb
 import numpy as np
 
 __all__ = ['estimate_noise_std', 'floor_percent', 'held_share', 'noise_floor_percent',
-           'quantum', 'REPEAT_TOLERANCE', 'robust_noise_std', 'STUCK_SHARE']
+           'quantum', 'REPEAT_TOLERANCE', 'repeat_tolerance', 'robust_noise_std', 'STUCK_SHARE']
 
 #: Steps below this share of the signal's magnitude count as repeats: a value written
 #: through a unit conversion, or perturbed at round-off level, is still the same A/D count.
@@ -77,19 +77,20 @@ def estimate_noise_std(measurement: np.ndarray) -> float:
         dev = np.abs(d - np.median(d))
         cut = float(np.quantile(dev, _KEEP))
         # ties (quantised data) stay together when the last bits move
-        kept = dev[dev <= cut * (1.0 + 1e-6) + _repeat_tolerance(y)]
+        kept = dev[dev <= cut * (1.0 + 1e-6) + repeat_tolerance(y)]
         rms = np.sqrt(np.mean(kept ** 2) / _TRIM_FACTOR)
         estimates.append(rms / np.sqrt(comb(2 * order, order)))
     sigma = min(estimates) if estimates else 0.0
     steps = np.abs(np.diff(y))
-    tol = _repeat_tolerance(y)
+    tol = repeat_tolerance(y)
     steps = steps[steps > tol]
     if steps.size and held_share(y) > 0.2:
         sigma = max(sigma, float(np.min(steps)) / np.sqrt(12.0))
     return float(sigma)
 
 
-def _repeat_tolerance(y: np.ndarray) -> float:
+def repeat_tolerance(y: np.ndarray) -> float:
+    """Steps of ``y`` at most this large are repeats: its round-off (:data:`REPEAT_TOLERANCE`)."""
     return REPEAT_TOLERANCE * float(np.max(np.abs(y))) if y.size else 0.0
 
 
@@ -101,7 +102,7 @@ STUCK_SHARE = 0.2
 
 def _in_repeat_runs(y: np.ndarray) -> np.ndarray:
     """Whether each sample repeats a neighbour (to round-off)."""
-    rep = np.abs(np.diff(y)) <= _repeat_tolerance(y)
+    rep = np.abs(np.diff(y)) <= repeat_tolerance(y)
     out = np.zeros(y.size, dtype=bool)
     out[1:] |= rep
     out[:-1] |= rep
@@ -113,7 +114,7 @@ def held_share(measurement: np.ndarray) -> float:
     y = np.asarray(measurement, dtype=np.float64)
     if y.size < 2:
         return 0.0
-    return float(np.mean(np.abs(np.diff(y)) <= _repeat_tolerance(y)))
+    return float(np.mean(np.abs(np.diff(y)) <= repeat_tolerance(y)))
 
 
 def quantum(measurement: np.ndarray) -> float:
@@ -127,7 +128,7 @@ def quantum(measurement: np.ndarray) -> float:
     """
     y = np.asarray(measurement, dtype=np.float64)
     d = np.abs(np.diff(y))
-    d = d[d > _repeat_tolerance(y)]
+    d = d[d > repeat_tolerance(y)]
     if d.size < 10:
         return 0.0
     q = float(np.min(d))
