@@ -62,9 +62,10 @@ def test_a_half_sample_is_never_claimed_and_one_sample_is_not_refused(seed, shif
     """The fitted delay on each side of the rule, with margin, and what the round says.
 
     Measured over 8 noise seeds: the half sample fitted 0.50-0.52 intervals (noise
-    0.1 % of the span) and 0.49-0.57 (0.4 %); one sample 0.99-1.06 (0.4 %) and
+    0.1 % of the span) and 0.49-0.56 (0.4 %); one sample 0.99-1.06 (0.4 %) and
     1.00-1.02 (0.1 %). Whether the one-sample block is then accepted or 'training
-    only' varies with the seed (6 of 8 accepted at 0.4 %); the rule never refuses it.
+    only' varies with the seed (6 of 8 accepted at 0.4 %); the rule never refuses it
+    (``python bench/dead_time_samples.py``).
     """
     t = np.arange(0.0, 2000 * DT_S, DT_S)
     v = multisine(t, amplitude_ma=1.8)

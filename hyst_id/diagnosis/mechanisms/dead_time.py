@@ -78,8 +78,8 @@ class DeadTime(Mechanism):
         Interpolated between samples, such a delay averages each command with the
         one before: a smoothing that soaks up misfit (a sum of plays behind a curved
         map under a chirp fitted 0.5 samples; a new user's review), not a delay the
-        record shows. True one-sample delays of the reference chain fitted 1.01-1.06
-        samples (4 noise seeds, 0.05 s; ``docs/diagnosis.md``).
+        record shows. True one-sample delays of the reference chain fit 0.99-1.06
+        intervals, half samples 0.49-0.56 (``python bench/dead_time_samples.py``).
         """
         if ctx is None or not ctx.dt_s > 0.0:
             return ''
