@@ -158,17 +158,15 @@ def find_artefacts(t_s: np.ndarray, command: np.ndarray, measurement: np.ndarray
     out = _frozen(t, v, y, span, sigma, q, unit, reversals)
     out += _glitches(t, y, sigma, q, unit, near_turn)
     q_std = q / np.sqrt(12.0)
-    coarse = q > 0.0 and (round(span / q) + 1 <= COARSE_LEVELS // 4
-                          or (round(span / q) + 1 <= COARSE_LEVELS and sigma <= 1.5 * q_std))
-    if coarse:
-        levels = int(round(span / q)) + 1
+    levels = int(round(span / q)) + 1 if q > 0.0 else 0
+    if 0 < levels <= COARSE_LEVELS and (levels <= COARSE_LEVELS // 4 or sigma <= 1.5 * q_std):
         floor = ('the step, not noise, sets the noise floor' if sigma <= 1.5 * q_std else
                  f'the noise (std {_g(sigma)}{_u(unit)}) is larger and sets the floor')
         out.append(Artefact('quantised', (), (
             f'the reading takes {levels} levels {_g(q)}{_u(unit)} apart (an A/D step of '
             f'{100.0 * q / span:.2g} % of its span, q/sqrt(12) = {_g(q_std)}{_u(unit)}): '
-            f'{floor}; changes smaller than a step do not show, and a quantised reading is '
-            'the sensor, not the plant')))
+            f'{floor}; changes smaller than a step do not show. A grid is the A/D of the '
+            'sensor (or a plant that moves in steps: a stepper, detents), not a loop shape')))
     out += _jitter(t)
     return out
 
@@ -182,7 +180,7 @@ def _frozen(t: np.ndarray, v: np.ndarray, y: np.ndarray, span: float, sigma: flo
     v_span = float(np.ptp(v))
     typical = float(np.median(np.abs(np.diff(y))))
     found: dict[str, list[tuple[int, int]]] = {'frozen': [], 'clipped': []}
-    runs = [r for r in _runs(rep) if r[1] >= 1]
+    runs = _runs(rep)
     physics = _holds_at_reversals(np.array([r[0] for r in runs], dtype=int), reversals)
     for (first, count), held in zip(runs, physics):
         n = count + 1                               # samples in a run of ``count`` repeats
@@ -244,10 +242,7 @@ def _glitches(t: np.ndarray, y: np.ndarray, sigma: float, q: float, unit: str,
         near = mag[max(i - 4, 0):i + 1]
         far = np.r_[mag[max(i - 8, 0):max(i - 4, 0)], mag[i + 1:i + 5]]
         return mag[i - 2] >= np.max(near) and not (far.size and np.max(far) >= 0.5 * least)
-    idx = np.array([i for i in idx if alone(int(i))], dtype=int)
-    if not idx.size:
-        return []
-    idx = idx[~turns[idx]]
+    idx = np.array([i for i in idx if alone(int(i)) and not turns[i]], dtype=int)
     if not idx.size:
         return []
     size = np.abs(dev[idx - 2])
