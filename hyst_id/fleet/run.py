@@ -36,6 +36,7 @@ import itertools
 import json
 import os
 from pathlib import Path
+import re
 import time
 from typing import Any, Callable, Iterable
 
@@ -103,12 +104,27 @@ def _walk(path: Path, named: bool = False) -> Iterable[Path]:
         if path.suffix.lower() in (_NAMED_SUFFIXES if named else _RECORDING_SUFFIXES):
             yield path
         return
-    if (path / 'metadata.yaml').exists():
+    if (path / 'metadata.yaml').exists() or _bag_without_metadata(path):
         yield path
         return
     if path.is_dir():
         for child in sorted(path.iterdir()):
             yield from _walk(child)
+
+
+def _bag_without_metadata(path: Path) -> bool:
+    """A directory whose MCAP files are named after it: one bag whose recorder was killed.
+
+    rosbag2 names them ``<dir>_0.mcap``, ``<dir>_1.mcap`` …, rosbags ``<dir>.mcap``,
+    and writes ``metadata.yaml`` last. Such a directory is its bag (its valve is its
+    parent folder's, as a complete bag's), not a folder of recordings: an independent
+    reviewer's killed recording had become a valve of its own.
+    """
+    if not path.is_dir():
+        return False
+    mcaps = list(path.glob('*.mcap'))
+    pattern = re.compile(re.escape(path.name) + r'(_[0-9]+)?')
+    return bool(mcaps) and all(pattern.fullmatch(m.stem) for m in mcaps)
 
 
 def result_path(out_dir: Path, recording: Path) -> Path:

@@ -42,7 +42,7 @@ from builtin_interfaces.msg import Time
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock
 
-from hyst_id.errors import ConfigError, HystIdError, RecordingError
+from hyst_id.errors import ConfigError, HystIdError, RecordingError, TruncatedBagError
 from hyst_id.io.bag import default_typestore, iter_bag_messages, open_bag
 from hyst_id.nodes.support import (
     HystNode,
@@ -91,13 +91,17 @@ class Replay(HystNode):
             raise ConfigError('replay: set the bag parameter (-p bag:=PATH)')
         self.path = Path(self.p('bag')).expanduser()
         selected = [t for t in self.p('topics') if t]
-        with open_bag(self.path, recover_truncated=self.p('recover_truncated')) as bag:
-            available = dict(bag.topics)
-            counts = dict(bag.counts)
-            latched = set(bag.latched)
-            if selected and selected != ['*']:
-                bag.check_topics(selected)
-                available = {t: available[t] for t in selected}
+        try:
+            with open_bag(self.path, recover_truncated=self.p('recover_truncated')) as bag:
+                available = dict(bag.topics)
+                counts = dict(bag.counts)
+                latched = set(bag.latched)
+                if selected and selected != ['*']:
+                    bag.check_topics(selected)
+                    available = {t: available[t] for t in selected}
+        except TruncatedBagError as exc:     # the remedy as a node's parameter is spelled
+            raise TruncatedBagError(str(exc).replace(
+                'recover_truncated=True', '-p recover_truncated:=true')) from None
         self._topics = available
         self._typestore = default_typestore()
         self._pubs = {}
@@ -110,6 +114,9 @@ class Replay(HystNode):
             self._pubs[topic] = self.create_publisher(cls, topic, _qos(topic, topic in latched))
         if not self._pubs:
             raise RecordingError(f'{self.path}: no playable topics')
+        if not any(counts.get(t, 0) for t in self._pubs):
+            raise RecordingError(f'{self.path}: its topics hold no messages '
+                                 f'({", ".join(sorted(self._pubs))}): nothing to replay')
         self._clock_pub = (self.create_publisher(Clock, '/clock', _qos('/clock'))
                            if self.p('publish_clock') else None)
         self.published = 0

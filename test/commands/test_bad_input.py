@@ -76,6 +76,22 @@ def wrong_type_bag(tmp: Path) -> Path:
     return path
 
 
+def clock_jump_bag(tmp: Path) -> Path:
+    """Header stamps set back 5 s from message 400 on (a clock reset), log times in order."""
+    path = tmp / 'clock_jump'
+    cfg = TopicConfig.for_channel('position')
+    with BagWriter(path) as writer:
+        writer.add_topic(cfg.command_topic, 'std_msgs/msg/Float64')
+        writer.add_topic(cfg.measurement_topic, cfg.measurement_type)
+        for i, t in enumerate(T):
+            t_ns = int(1e18 + t * 1e9)
+            stamp = t_ns - (5 * 10**9 if i >= 400 else 0)
+            writer.write(cfg.command_topic, t_ns, {'data': float(V[i])})
+            writer.write(cfg.measurement_topic, t_ns + 1000, {'header': {'stamp': stamp},
+                                                               'position': [float(Y[i])]})
+    return path
+
+
 def zero_stamp_bag(tmp: Path) -> Path:
     """Every message stamped 0 (header and log time): reading keeps one sample."""
     path = tmp / 'zero_stamps'
@@ -167,6 +183,7 @@ CASES = [
     ('zero-byte-mcap', lambda d: [str(_bytes(d / 'zero.mcap', b''))], 'bag'),
     ('bag-without-topics', lambda d: [str(no_topics_bag(d))], '/hyst_id/'),
     ('wrong-message-type', lambda d: [str(wrong_type_bag(d))], 'expected sensor_msgs'),
+    ('clock-jump-bag', lambda d: [str(clock_jump_bag(d))], 'stamps jump back by 4.95 s'),
     ('empty-topic', lambda d: [str(empty_topic_bag(d))], '/hyst_id/position'),
     ('nan-in-bag', lambda d: [str(make_bag(d / 'nanbag', measurement=nan_at(Y)))], 'NaN'),
     ('constant-command-bag', lambda d: [str(make_bag(d / 'cbag', command=np.full_like(V, 9.)))],

@@ -88,6 +88,26 @@ def test_find_recordings(fleet_dir):
     notes.unlink()
 
 
+def test_a_bag_without_metadata_is_one_bag_of_its_valve(tmp_path):
+    """A killed recorder's directory (MCAP named after it, no metadata.yaml) is its bag.
+
+    An independent reviewer's ``fleetin/trunc/trunc.mcap`` had been expanded into its file,
+    whose valve became ``trunc``; a folder of runs named otherwise is still searched.
+    """
+    bag = tmp_path / 'valve_c' / 'week0'
+    write_recording_bag(bag, _recording(0.15, 3))
+    (bag / 'metadata.yaml').unlink()
+    names = [m.name for m in bag.glob('*.mcap')]
+    runs = tmp_path / 'valve_d'
+    runs.mkdir()
+    for k in range(2):
+        (runs / f'run{k}.mcap').write_bytes((bag / names[0]).read_bytes())
+    found = find_recordings([str(tmp_path)])
+    assert found == [bag, runs / 'run0.mcap', runs / 'run1.mcap'], (found, names)
+    assert [r['valve'] for r in fleet_rows({'recording': str(p)} for p in found)] == [
+        'valve_c', 'valve_d', 'valve_d']
+
+
 def test_fleet_rows_errors_resume_and_trends(fleet_dir, tmp_path):
     recs = find_recordings([str(fleet_dir)])
     seen = []

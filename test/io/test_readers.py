@@ -137,6 +137,27 @@ def test_zero_order_hold_pairing_sort_and_duplicates(tmp_path: Path) -> None:
     assert 'dropped 3 /hyst_id/position samples before the first command' in notes
 
 
+def test_stamps_that_jump_back_are_refused_not_sorted(tmp_path: Path) -> None:
+    """A clock set back mid-run is an error naming the jump; a swapped pair above is sorted.
+
+    An independent reviewer's bag (header stamps set back 5 s from message 600) was
+    sorted, lost 50 samples as duplicates and was identified at 137 x the floor.
+    """
+    t = np.arange(1200) * 0.05
+    stamps = T0 + np.round(t * 1e9).astype(np.int64)
+    stamps[600:] -= 5 * 10**9
+    with BagWriter(tmp_path / 'bag') as bag:
+        bag.add_topic('/hyst_id/command', 'std_msgs/msg/Float64')
+        bag.add_topic('/hyst_id/position', 'sensor_msgs/msg/JointState')
+        for k in range(t.size):
+            bag.write('/hyst_id/command', int(T0 + round(t[k] * 1e9)), {'data': np.sin(t[k])})
+            bag.write('/hyst_id/position', int(T0 + round(t[k] * 1e9)) + 1000, {
+                'header': {'stamp': int(stamps[k])}, 'position': [float(k)]})
+    with pytest.raises(RecordingError, match=r'/hyst_id/position in .*: the header stamps '
+                       r'jump back by 4.95 s \(99 median intervals\) at message 600 of 1200'):
+        read_recording(tmp_path / 'bag', 'position')
+
+
 @pytest.mark.parametrize('stop, gap, noted', [
     (300, (0, 0), 'ends 15 s (50 % of the record) before /hyst_id/position: its last value '
                   'was held'),

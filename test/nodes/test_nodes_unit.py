@@ -42,7 +42,8 @@ from hyst_id.compensation.params_file import (  # noqa: E402
 from hyst_id.errors import ConfigError, RecordingError  # noqa: E402
 from hyst_id.identification import identify  # noqa: E402
 from hyst_id.identification.chains import chain_spec  # noqa: E402
-from hyst_id.io.bag import iter_bag_messages, open_bag, write_recording_bag  # noqa: E402
+from hyst_id.io.bag import (  # noqa: E402
+    BagWriter, iter_bag_messages, open_bag, write_recording_bag)
 from hyst_id.io.recording import Recording  # noqa: E402
 from hyst_id.live import pair_streams  # noqa: E402
 from hyst_id.nodes.actuator_driver import (  # noqa: E402
@@ -265,10 +266,22 @@ def test_node_main_reports_bad_input_in_one_line(ros_domain, tmp_path, capfd):
     junk = tmp_path / 'junk.mcap'
     junk.write_bytes(b'not a bag at all')
     assert replay.main(['--ros-args', '-p', f'bag:={junk}']) == 2
+    with BagWriter(tmp_path / 'empty') as bag:      # topics, no messages: not a success
+        bag.add_topic('/hyst_id/command', 'std_msgs/msg/Float64')
+    assert replay.main(['--ros-args', '-p', f'bag:={tmp_path / "empty"}']) == 2
+    cut = tmp_path / 'cut.mcap'                      # the remedy spelled as a node parameter
+    whole = tmp_path / 'whole'
+    write_recording_bag(whole, Recording(np.arange(400) * 0.05, np.sin(np.arange(400) * 0.1),
+                                         np.cos(np.arange(400) * 0.1), 'position'))
+    data = next(whole.glob('*.mcap')).read_bytes()
+    cut.write_bytes(data[:len(data) // 2])
+    assert replay.main(['--ros-args', '-p', f'bag:={cut}']) == 2
     err = capfd.readouterr()
     text = err.out + err.err
     assert 'Traceback' not in text
     assert 'no such file' in text and 'cannot read bag' in text
+    assert 'its topics hold no messages (/hyst_id/command): nothing to replay' in text
+    assert '-p recover_truncated:=true' in text and 'recover_truncated=True' not in text
 
 
 # ------------------------------------------------------------------ compensator
