@@ -283,6 +283,7 @@ def format_diagnosis(d: Any) -> str:
         lines += [f'{head}: {f.mechanism} - {f.title}', f'    {f.explanation}',
                   f'    placed: {f.placement}', '    fitted block:']
         lines += _params_lines(f.params)
+        lines += [f'      on an edge: {words}' for words in f.at_edges]
         judged = d.extra.get('judged_holdout') or {}
         where = ('' if judged.get('n_samples', 0) >= judged.get('n_holdout', 0) else
                  ' (all held-out samples; the judged ones decide, see the table)')
@@ -321,6 +322,9 @@ def format_diagnosis(d: Any) -> str:
     part = ('' if judged.get('n_samples', 0) >= judged.get('n_holdout', 0) else
             f"  (held-out %e_r over all {judged['n_holdout']} held-out samples; gain, share "
             f"and z over the {judged['n_samples']} judged ones)")
+    if d.rounds:
+        lines += ['', "each block below is fitted around its round's chain (a local fit); a "
+                  "chosen block's figures above are after the chain was re-identified with it"]
     for r in d.rounds:
         lines += ['', f'mechanisms tested (round {r["round"]}):{part}',
                   f'  {"mechanism":22s}{"held-out %e_r":>14s}{"gain":>8s}{"share":>7s}'

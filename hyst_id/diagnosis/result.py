@@ -139,6 +139,8 @@ class Finding:
     #: the block against the model before it, each time block of the record predicted by
     #: a refit on the others (:func:`hyst_id.diagnosis.blocked_cv.confirm`), at acceptance
     blocked_cv: dict = field(default_factory=dict)
+    #: searched parameters that ended on an edge of their search (words each)
+    at_edges: list = field(default_factory=list)
 
     def to_dict(self) -> dict:
         """JSON-ready form."""
@@ -152,7 +154,7 @@ class Finding:
                 'delta_bic': self.delta_bic, 'holdout_z': self.holdout_z,
                 'alternatives': jsonable(list(self.alternatives)),
                 'compensation': dict(self.compensation),
-                'blocked_cv': jsonable(self.blocked_cv)}
+                'blocked_cv': jsonable(self.blocked_cv), 'at_edges': list(self.at_edges)}
 
 
 @dataclass

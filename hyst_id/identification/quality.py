@@ -51,7 +51,7 @@ from hyst_id.identification.loop import loop_orientation, reversal_response
 from hyst_id.identification.refine import refine
 from hyst_id.identification.result import Identification
 from hyst_id.signals.artefacts import find_artefacts
-from hyst_id.signals.noise import estimate_noise_std
+from hyst_id.signals.noise import estimate_noise_std, offset_words
 from hyst_id.signals.reversals import half_period_s
 from hyst_id.solvers.gaass import GaassSolver
 
@@ -143,6 +143,8 @@ def assess(ident: Identification, rec: Recording,
         spec = replace(ident.spec(), calibration=None)
     out = artefact_warnings(rec)
     out += response_warnings(ident.er_percent, rec.measurement)
+    out += [w for w in [offset_words(ident.er_percent, rec.measurement,
+                                     rec.measurement_unit)] if w]
     out += orientation_warnings(rec, _sign(ident))
     out += fit_warnings(ident) + floor_estimate_warnings(ident, rec.n_samples)
     out += domain_edge_warnings(ident, rec, spec)
@@ -198,8 +200,8 @@ def orientation_warnings(rec: Recording, sign: float = 1.0) -> list[str]:
     out = []
     if sign < 0:
         out.append('output sign -1: the measurement falls as the chain output rises, so the '
-                   'parameters describe -measurement (c_t, c_b and the output lines in '
-                   'negated measurement units)')
+                   'parameters describe -measurement (their output-side values in negated '
+                   'measurement units)')
     orientation = loop_orientation(rec.command, y)
     if orientation > 0.005:
         out.append(f'the loop runs clockwise (orientation {orientation:+.2f}): the model makes '
@@ -232,13 +234,19 @@ def fit_warnings(ident: Identification) -> list[str]:
                    f'misses by %e_r {ident.er_percent:.4g}: the model misses part of the '
                    'response; look at the residual plot')
     elif floor > 0 and ident.er_percent > FIT_FACTOR * floor:
-        hint = ('; a measurement that follows the command with a lag has sensor dynamics '
-                'the position chain lacks: try --channel pressure (a first-order sensor) or '
-                'flow (second order)' if ident.channel == 'position' else '')
+        hint = ('; curved branches (a piezo stack, a ferrite core, a Bouc-Wen loop) are the '
+                "smooth family's: try --model auto" if getattr(ident, 'family', 'tk') == 'tk'
+                else '')
+        hint += ('; a measurement that follows the command with a lag has sensor dynamics '
+                 'the position chain lacks: try --channel pressure (a first-order sensor) or '
+                 'flow (second order)' if ident.channel == 'position' else '')
         out.append(f'the best %e_r is {ident.er_percent / floor:.1f} x the noise floor: the '
                    'model misses part of the response (unmodelled dynamics, drift, a loop '
                    "shape it cannot make); look at the residual plot, and 'hyst-id diagnose' "
-                   f'names what is missing where its library has it{hint}')
+                   f'names what is missing where its library has it{hint}. The floor is '
+                   "estimated from the measurement's sample-to-sample changes, which filtered "
+                   '(coloured) noise or a slow interference hides: with such noise the ratio '
+                   'overstates the miss')
     er = np.array([r.er_percent for r in ident.runs])
     off = int(np.sum(er > CONVERGED_FACTOR * er.min()))
     if off:

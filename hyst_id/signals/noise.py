@@ -42,7 +42,8 @@ from math import comb
 import numpy as np
 
 __all__ = ['estimate_noise_std', 'floor_percent', 'held_share', 'noise_floor_percent',
-           'quantum', 'REPEAT_TOLERANCE', 'repeat_tolerance', 'robust_noise_std', 'STUCK_SHARE']
+           'OFFSET_SPANS', 'offset_words', 'quantum', 'REPEAT_TOLERANCE', 'repeat_tolerance',
+           'robust_noise_std', 'STUCK_SHARE']
 
 #: Steps below this share of the signal's magnitude count as repeats: a value written
 #: through a unit conversion, or perturbed at round-off level, is still the same A/D count.
@@ -159,6 +160,30 @@ def floor_percent(measurement: np.ndarray, sigma: float) -> float:
     """
     y = np.asarray(measurement, dtype=np.float64)
     return float(np.sqrt(y.size * sigma ** 2 / max(float(y @ y), 1e-300)) * 100.0)
+
+
+#: A measurement whose mean lies further from zero than this many spans has %e_r read small.
+OFFSET_SPANS = 1.0
+
+
+def offset_words(er_percent: float, measurement: np.ndarray, unit: str = '') -> str:
+    """Why %e_r reads small on a measurement far from zero, and the error in its units ('').
+
+    %e_r (Eq. 7) divides by the measurement's RMS about zero, so an offset (a
+    4-20 mA transmitter, a reading of 1000 kPa swinging by 100) makes it small for
+    the same fit: an independent reviewer's 0.5 % of the span read 0.046 %.
+    """
+    y = np.asarray(measurement, dtype=np.float64)
+    span = float(np.ptp(y)) if y.size else 0.0
+    mean = float(np.mean(y)) if y.size else 0.0
+    if not span > 0.0 or abs(mean) <= OFFSET_SPANS * span or not np.isfinite(er_percent):
+        return ''
+    rms = er_percent / 100.0 * float(np.sqrt(np.mean(y * y)))
+    u = f' {unit}' if unit else ''
+    return (f"%e_r (Eq. 7) divides by the measurement's RMS about zero, which its offset "
+            f'dominates (mean {mean:.4g}{u} against a span of {span:.4g}{u}), so it reads '
+            f"small: the best run's RMS error is {rms:.3g}{u}, {100.0 * rms / span:.3g} % of "
+            'the span')
 
 
 def robust_noise_std(measurement: np.ndarray) -> float:

@@ -87,8 +87,8 @@ def clock_jump_bag(tmp: Path) -> Path:
             t_ns = int(1e18 + t * 1e9)
             stamp = t_ns - (5 * 10**9 if i >= 400 else 0)
             writer.write(cfg.command_topic, t_ns, {'data': float(V[i])})
-            writer.write(cfg.measurement_topic, t_ns + 1000, {'header': {'stamp': stamp},
-                                                               'position': [float(Y[i])]})
+            writer.write(cfg.measurement_topic, t_ns + 1000,
+                         {'header': {'stamp': stamp}, 'position': [float(Y[i])]})
     return path
 
 

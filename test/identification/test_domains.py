@@ -297,3 +297,25 @@ def test_a_measurement_that_does_not_follow_the_command_is_said_so(seed):
     follows = 0.5 * v + 3.0 + rng.normal(0.0, 0.5, t.size)     # signal std 2.8 x the noise
     fit = 100.0 * np.sqrt(np.mean((follows - 0.5 * v - 3.0) ** 2) / np.mean(follows ** 2))
     assert response_warnings(fit, follows) == []
+
+
+@pytest.mark.parametrize('offset, named', [(1000.0, True), (-300.0, True), (30.0, False)])
+def test_an_offset_far_from_zero_says_what_er_reads(offset, named):
+    """%e_r (Eq. 7) divides by the RMS about zero: far from zero the error is also in units.
+
+    An independent reviewer's reading of 1000 kPa swinging by about 100 was fitted to
+    0.5 % of its span and reported as %e_r 0.046 with nothing said.
+    """
+    from hyst_id.signals.noise import offset_words
+    t = np.arange(2000) * 0.05
+    y = offset + 48.0 * np.sin(2 * np.pi * 0.1 * t)
+    e = np.random.default_rng(3).normal(0.0, 0.48, t.size)      # 0.5 % of the span
+    er = 100.0 * np.sqrt(np.mean(e ** 2) / np.mean(y ** 2))
+    words = offset_words(er, y, 'kPa')
+    if not named:
+        assert words == ''
+        return
+    rms = float(np.sqrt(np.mean(e ** 2)))
+    assert (f"the best run's RMS error is {rms:.3g} kPa, {100 * rms / np.ptp(y):.3g} % of the "
+            'span') in words, words
+    assert f'mean {np.mean(y):.4g} kPa against a span of {np.ptp(y):.4g} kPa' in words

@@ -40,8 +40,8 @@ from typing import Any, Sequence
 
 import numpy as np
 
-__all__ = ['COMPENSATION_KINDS', 'STAGES', 'Context', 'Mechanism', 'Quantity', 'clip_theta',
-           'rate_correlation']
+__all__ = ['COMPENSATION_KINDS', 'EDGE_FRACTION', 'STAGES', 'Context', 'Mechanism', 'Quantity',
+           'clip_theta', 'rate_correlation']
 
 #: How a block is made up for in operation: by a correction in the compensator's
 #: model (:mod:`hyst_id.compensation.augment`); by the compensator's tracking or the
@@ -52,6 +52,8 @@ COMPENSATION_KINDS = ('in-line', 'tracking', 'limits', 'family', 'not needed', '
 
 #: Stages in signal order.
 STAGES = ('command', 'actuator', 'position', 'quantity', 'sensor', 'output')
+#: A searched parameter within this share of its search's width from an edge is on it.
+EDGE_FRACTION = 1e-3
 
 
 @dataclass(frozen=True)
@@ -215,6 +217,25 @@ class Mechanism:
         are scored with the grid's candidates and kept as they are when best.
         """
         return []
+
+    def at_edges(self, theta: np.ndarray, ctx: Context) -> list[str]:
+        """Searched parameters that ended on an edge of their search, one sentence each.
+
+        An edge at zero is the physics' own limit (no lag, no width) and is not
+        named. An independent reviewer's creep of 1.5 s was reported as 2 s, the
+        lower end of its search, as if measured.
+        """
+        bounds = self.bounds(ctx)
+        out = []
+        for i, name in enumerate(self.names[:len(bounds)]):
+            lo, hi = (float(x) for x in bounds[i])
+            x, unit = float(theta[i]), (self.units[i] if i < len(self.units) else '')
+            for edge, side in ((lo, 'lower'), (hi, 'upper')):
+                if edge != 0.0 and hi > lo and abs(x - edge) <= EDGE_FRACTION * (hi - lo):
+                    out.append(f'{name} = {x:.4g} {unit} sits at the {side} end of its search '
+                               f'({edge:.4g} {unit}): the data may want a value beyond it, so '
+                               'read it as a bound, not a measurement')
+        return out
 
     def implausible(self, theta: np.ndarray, coef: np.ndarray, span: tuple[float, float],
                     noise_std: float, ctx: Context | None = None,
