@@ -63,7 +63,7 @@ from hyst_id.models.registry import DEFAULT_FAMILY, FAMILIES, get_family
 
 __all__ = ['COMPENSATOR_NAMES', 'ALL_MODEL_NAMES', 'NODE_COMMAND_LIMITS', 'command_limits_for',
            'compensator_names', 'compensator_values', 'read_compensator_params',
-           'write_compensator_params']
+           'read_set_document', 'write_compensator_params']
 
 #: The compensator node's default ``min_command`` / ``max_command`` (the paper's 4-20 mA).
 NODE_COMMAND_LIMITS = (4.0, 20.0)
@@ -306,3 +306,47 @@ def read_compensator_params(path: str | Path, node_name: str | None = None) -> d
         return compensator_values(params)
     except ConfigError as exc:
         raise ConfigError(f'{path}: {exc}') from None
+
+
+def read_set_document(doc: Any, sensor_names: tuple[str, ...] = ()
+                      ) -> tuple[str, dict[str, Any], float]:
+    """The channel, the compensator's values and the %e_r of an identified-parameters document.
+
+    The document is :func:`hyst_id.live.documents.result_document`'s
+    (``compensator_params``), a bare set or one under ``params``; ``sensor_names``
+    found in ``params`` come as ``tracking.<name>``.
+
+    Raises
+    ------
+    ValueError
+        What is wrong, in words: not an object, an unknown family, the names missing,
+        a value that is not a number. An independent reviewer's malformed documents had
+        been refused with a bare ``KeyError('m_l')``.
+    """
+    if not isinstance(doc, dict):
+        raise ValueError(f'a JSON object was expected, got {type(doc).__name__}')
+    params = doc.get('compensator_params') or doc.get('params', doc)
+    if not isinstance(params, dict):
+        raise ValueError(f'its parameters must be an object, got {type(params).__name__}')
+    family = str(params.get('family', doc.get('family', DEFAULT_FAMILY)))
+    if family not in FAMILIES:
+        raise ValueError(f'unknown family {family!r} (known: {", ".join(FAMILIES)})')
+    names = compensator_names(family)
+    missing = [n for n in names if n not in params]
+    if missing:
+        raise ValueError(f'{", ".join(missing)} missing: a {family} set has '
+                         f'{", ".join(names)}')
+
+    def number(key: str, value: Any) -> float:
+        try:
+            return float(value)
+        except (TypeError, ValueError):
+            raise ValueError(f'{key} is {value!r}, not a number') from None
+    values: dict[str, Any] = {n: number(n, params[n]) for n in names}
+    values['family'] = family
+    values['output_sign'] = number('output_sign', doc.get('output_sign',
+                                                          params.get('output_sign', 1.0)))
+    full = doc.get('params') if isinstance(doc.get('params'), dict) else {}
+    values.update({f'tracking.{k}': number(k, full[k]) for k in sensor_names if k in full})
+    er = number('er_percent', doc.get('compensator_er_percent', doc.get('er_percent', math.nan)))
+    return str(doc.get('channel', params.get('channel', ''))), values, er

@@ -58,8 +58,13 @@ def tidy_stream(t_ns: np.ndarray, values: np.ndarray, name: str,
         t_ns, values = t_ns[order], values[order]
     keep = np.append(t_ns[1:] != t_ns[:-1], True)
     if not keep.all():
-        notes.append(f'{name}: dropped {int((~keep).sum())} messages with a duplicate stamp '
-                     f'(kept the last at each stamp)')
+        kept, dropped = np.flatnonzero(keep), np.flatnonzero(~keep)
+        other = int(np.sum(values[dropped] != values[kept[np.searchsorted(kept, dropped)]]))
+        notes.append(f'{name}: dropped {dropped.size} messages with a duplicate stamp (kept the '
+                     'last at each stamp' + (
+                         f'; {other} of them carried another value: two messages stamped on '
+                         'one clock tick, as messages stamped on arrival under use_sim_time '
+                         'can be when they race the /clock of a replay' if other else '') + ')')
         t_ns, values = t_ns[keep], values[keep]
     return t_ns, values
 
@@ -156,7 +161,10 @@ def pair_streams(cmd_t_ns: np.ndarray, cmd_v: np.ndarray, meas_t_ns: np.ndarray,
         raise RecordingError(
             f'no {names[1]} sample at or after the first {names[0]} message (measurements '
             f'{meas_t[0] / 1e9:.3f}..{meas_t[-1] / 1e9:.3f} s, first command '
-            f'{cmd_t[0] / 1e9:.3f} s since the epoch; different clocks?)')
+            f'{cmd_t[0] / 1e9:.3f} s since the epoch; different clocks? a stream stamped in '
+            'its header and one stamped on arrival differ by the age of a replayed bag: '
+            'replay with use_sim_time:=true, or stamp both on arrival, topics.stamp_source: '
+            'log)')
     if not keep.all():
         notes.append(f'dropped {int((~keep).sum())} {names[1]} samples before the first '
                      f'command')

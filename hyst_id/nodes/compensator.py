@@ -63,7 +63,7 @@ from hyst_id.compensation import CommandLimits, InverseModel
 from hyst_id.compensation.augment import AugmentedCompensator
 from hyst_id.compensation.inverse import warm_up
 from hyst_id.compensation.params_file import (ALL_MODEL_NAMES, compensator_names,
-                                              NODE_COMMAND_LIMITS)
+                                              NODE_COMMAND_LIMITS, read_set_document)
 from hyst_id.errors import InvalidParametersError
 from hyst_id.io.recording import CHANNELS
 from hyst_id.models.registry import DEFAULT_FAMILY, FAMILIES, get_family
@@ -423,6 +423,8 @@ class Compensator(HystNode):
         log = self.get_logger()
         try:
             doc = json.loads(msg.data)
+            if not isinstance(doc, dict):
+                raise ValueError(f'a JSON object was expected, got {type(doc).__name__}')
             if 'compensator_params' in doc and doc['compensator_params'] is None:
                 log.warning('identified parameters not handed over: '
                             + str(doc.get('compensator_note') or 'no compensator set'))
@@ -432,19 +434,9 @@ class Compensator(HystNode):
                 log.warning(f'ignored the identifier\'s {doc["source"]}: this compensator\'s '
                             f'set was loaded on purpose ({self._source}) and stays')
                 return
-            params = doc.get('compensator_params') or doc.get('params', doc)
-            channel = str(doc.get('channel', params.get('channel', '')))
-            family = str(params.get('family', doc.get('family', DEFAULT_FAMILY)))
-            if family not in FAMILIES:
-                raise ValueError(f'unknown family {family!r}')
-            values: dict[str, Any] = {n: float(params[n]) for n in compensator_names(family)}
-            values['family'] = family
-            values['output_sign'] = float(doc.get('output_sign', params.get('output_sign', 1.0)))
-            er = float(doc.get('compensator_er_percent', doc.get('er_percent', _NAN)))
-            full = doc.get('params') if isinstance(doc.get('params'), dict) else {}
-            values.update({f'tracking.{k}': float(full[k]) for k in SENSOR_NAMES if k in full})
-        except (ValueError, TypeError, KeyError, AttributeError) as exc:
-            self.note_refused('identified parameters', f'not the expected JSON ({exc})')
+            channel, values, er = read_set_document(doc, SENSOR_NAMES)
+        except ValueError as exc:       # json's own errors are ValueErrors too
+            self.note_refused('identified parameters', f'not the expected JSON: {exc}')
             return
         if channel != self.p('channel'):
             log.info(f'ignored identified parameters of channel {channel!r} (this compensator '

@@ -16,6 +16,8 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -26,6 +28,7 @@ from hyst_id.identification.chains import chain_spec
 CANON = np.array([1.01, 1.05, 0.10, 0.15, -0.25, 0.50, 14.0, 7.0, 1.0, -0.15, 0.15])
 T = np.arange(0.0, 60.0, 0.5)
 DESIRED = 9.0 + np.sin(2 * np.pi * T / 12.0)       # Eq. 25
+PAPER_SET = dict(zip(chain_spec('position').names, (float(x) for x in CANON)))
 
 
 def plant(commands: np.ndarray, v0: float = 9.0, sign: float = 1.0) -> np.ndarray:
@@ -130,3 +133,27 @@ def test_swap_keeps_state_inside_the_new_loop():
 def test_invalid_sets_are_rejected_with_the_reason(values, reason):
     with pytest.raises(InvalidParametersError, match=reason):
         InverseModel.from_mapping(values)
+
+
+@pytest.mark.parametrize('doc, words', [
+    ([1, 2], 'a JSON object was expected, got list'),
+    ({'channel': 'position'}, 'm_l, m_r, m_t, m_b, c_l, c_r, c_t, c_b, m_bl, c_bl, c_br missing'),
+    ({'params': {'family': 'preisach'}}, "unknown family 'preisach' (known: "),
+    ({'params': 'm_l=1'}, 'its parameters must be an object, got str'),
+    ({'params': {**PAPER_SET, 'm_l': 'one'}}, "m_l is 'one', not a number"),
+])
+def test_a_malformed_set_document_is_named(doc, words):
+    """What an identified-parameters document lacks is said (was a bare ``KeyError('m_l')``)."""
+    from hyst_id.compensation.params_file import read_set_document
+    with pytest.raises(ValueError, match=re.escape(words)):
+        read_set_document(doc)
+
+
+def test_a_set_document_is_read_with_its_sensor_values():
+    from hyst_id.compensation.params_file import read_set_document
+    doc = {'channel': 'pressure', 'params': {**PAPER_SET, 'tau_s': 0.5}, 'er_percent': 0.7,
+           'output_sign': -1}
+    channel, values, er = read_set_document(doc, ('tau_s', 'zeta'))
+    assert (channel, er, values['output_sign'], values['family']) == ('pressure', 0.7, -1.0, 'tk')
+    assert values['tracking.tau_s'] == 0.5 and 'tracking.zeta' not in values
+    assert {k: values[k] for k in PAPER_SET} == PAPER_SET

@@ -79,7 +79,10 @@ def test_gaps_and_duplicates_are_reported():
     assert rec.n_samples == 370
     gap = [n for n in rec.notes if 'gap' in n]
     assert len(gap) == 1 and 'about 30 samples missing' in gap[0] and 'position' in gap[0]
-    assert any('duplicate' in n for n in rec.notes)
+    assert any('duplicate' in n and 'another value' not in n for n in rec.notes), rec.notes
+    clash = pair_streams(ct, cv, np.r_[mt, mt[7]], np.r_[mv, mv[7] + 1.0], 'position')
+    assert any('dropped 1 messages with a duplicate stamp (kept the last at each stamp; 1 of '
+               'them carried another value' in n for n in clash.notes), clash.notes
     with pytest.raises(RecordingError, match='no samples'):
         pair_streams(ct[:0], cv[:0], mt, mv, 'position')
 
