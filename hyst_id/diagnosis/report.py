@@ -108,6 +108,23 @@ def _alternative_lines(f: Any) -> list[str]:
     return lines
 
 
+def _left_over(d) -> list[str]:
+    """A named verdict that leaves more than :data:`FAR_FROM_FLOOR` x the floor is a part.
+
+    An independent reviewer's loop that widened with accumulated travel (outside the
+    library) was named ``rate_dependence`` with 37 x the floor left and nothing said.
+    """
+    judged = d.extra.get('judged_holdout') or {}
+    floor, final = judged.get('noise_floor_percent', 0.0), judged.get('final_er_percent', 0.0)
+    if d.verdict in ('none', 'unknown') or not d.findings or not floor > 0 \
+            or not final > FAR_FROM_FLOOR * floor:
+        return []
+    return [f'what is left after the findings: {final / floor:.1f} x the noise floor on the '
+            'judged held-out samples: the findings are not the whole story, and the rest is '
+            'physics outside the library or a block that did not fit (the empirical '
+            'regression above says how much a model could still gain)']
+
+
 def _params_lines(params: dict) -> list[str]:
     out = []
     for name, q in params.items():
@@ -276,6 +293,7 @@ def format_diagnosis(d: Any) -> str:
                      'stated, not claimed; what is missing is none of them, or not only them.')
     if d.empirical is not None:
         lines.append(f'what is left: {d.empirical.summary()}.')
+    lines += _left_over(d)
     for i, f in enumerate(d.findings):
         head = ('verdict' if f.mechanism == d.verdict else f'finding {i + 1}'
                 if confirmed(f.blocked_cv) else f'not confirmed ({i + 1})')
