@@ -284,6 +284,19 @@ def test_node_main_reports_bad_input_in_one_line(ros_domain, tmp_path, capfd):
     assert '-p recover_truncated:=true' in text and 'recover_truncated=True' not in text
 
 
+def test_a_refused_set_parameters_is_logged_in_words(ctx, capfd):
+    """An unknown name or a wrong type is said in the log (rclpy's answer names neither)."""
+    from rclpy.exceptions import ParameterNotDeclaredException
+    comp = _make(ctx, Compensator)
+    with pytest.raises(ParameterNotDeclaredException):
+        comp.set_parameters([Parameter('max_comand', value=1.0)])
+    result = comp.set_parameters([Parameter('max_command', value='high')])[0]
+    assert not result.successful
+    text = ''.join(capfd.readouterr())
+    assert 'set_parameters: max_comand refused, compensator has no such parameter' in text
+    assert "max_command refused, it is a double and was given a string ('high')" in text
+
+
 # ------------------------------------------------------------------ compensator
 def test_compensator_swaps_valid_sets_and_keeps_the_last_good(ctx):
     comp = _make(ctx, Compensator)

@@ -226,7 +226,30 @@ class HystNode(Node):
 
     def _widen_integers(self, params: list) -> list:
         widened = dict(widened_integers(params, self._float_names))
-        return [widened.get(prm.name, prm) for prm in params]
+        out = [widened.get(prm.name, prm) for prm in params]
+        self._say_refusals(out)
+        return out
+
+    def _say_refusals(self, params: list) -> None:
+        """Log (ERROR) what rclpy will refuse before our callback sees it, in words.
+
+        rclpy answers an unknown name with ``Invalid access to undeclared parameter(s): []``
+        and a wrong type with ``expected '3' got '4'``, and logs neither (an independent
+        reviewer's ``max_comand``).
+        """
+        for prm in params:
+            if not self.has_parameter(prm.name):
+                self.get_logger().error(
+                    f'set_parameters: {prm.name} refused, {self.get_name()} has no such '
+                    'parameter (a typo, or a key of another node?); it declares: '
+                    + ', '.join(sorted(n for n in self._param_table
+                                       if not n.startswith('topics.'))))
+                continue
+            have = self.get_parameter(prm.name).type_
+            if prm.type_ != have and prm.type_ != Parameter.Type.NOT_SET:
+                self.get_logger().error(
+                    f'set_parameters: {prm.name} refused, it is a {have.name.lower()} and '
+                    f'was given a {prm.type_.name.lower()} ({prm.value!r})')
 
     def _on_set_parameters(self, params: list) -> SetParametersResult:
         values = self.param_values()
