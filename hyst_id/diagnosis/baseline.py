@@ -66,7 +66,7 @@ def identify_base(settings) -> dict:
 
 
 def baseline_starts(rec_train: Recording, spec: ChainSpec, settings, *, thorough: bool = True,
-                    global_phase: bool | None = None
+                    global_phase: bool | None = None, others: list | None = None
                     ) -> tuple[list[np.ndarray], list[np.ndarray]]:
     """The best identified chains and the data-built starts.
 
@@ -88,6 +88,9 @@ def baseline_starts(rec_train: Recording, spec: ChainSpec, settings, *, thorough
     ``global_phase`` (default: as ``thorough``) adds identify's global phase
     (one run) to the quick search (the re-identification of a chain with its
     accepted blocks undone, :mod:`hyst_id.diagnosis.refit`).
+    ``others``: the best chain (raw parameters) of the thorough search's runs that
+    start on the other boundary is appended to it, for
+    :func:`hyst_id.diagnosis.challenge.chain_fit` to weigh.
     """
     base = identify_base(settings)
     runs = []
@@ -103,6 +106,9 @@ def baseline_starts(rec_train: Recording, spec: ChainSpec, settings, *, thorough
         own = [r for r in ident.runs if r.initial == spec.initial]
         if own:
             runs.append(min(own, key=lambda r: r.fun))
+        other = [r for r in ident.runs if r.initial != spec.initial]
+        if other and others is not None:
+            others.append(np.array(min(other, key=lambda r: r.fun).x_raw, dtype=float))
     x_fits = [np.array(r.x_raw, dtype=float) for r in sorted(runs, key=lambda r: r.fun)]
     return x_fits, structured_starts(spec, rec_train.t_s, rec_train.command,
                                      rec_train.measurement, x_fits[0][spec.sensor_slice])

@@ -59,7 +59,11 @@ from hyst_id.io.recording import Recording
 if TYPE_CHECKING:
     from hyst_id.diagnosis.result import DiagnoseSettings
 
-__all__ = ['CHALLENGE_FACTOR', 'chain_fit', 'challenge', 'withdrawn_note']
+__all__ = ['CHALLENGE_FACTOR', 'chain_fit', 'challenge', 'START_SHARE', 'withdrawn_note']
+
+#: Share of the other boundary's training gain that must lie before the command first sweeps
+#: its training range, where the two boundaries differ (:func:`chain_fit`).
+START_SHARE = 0.5
 
 #: A baseline within this multiple of the judged held-out floor makes its claims face
 #: :func:`challenge` (the level below which :data:`hyst_id.diagnosis.driver.UNKNOWN_FACTOR`
@@ -95,20 +99,52 @@ def chain_fit(rec_train: Recording, spec: ChainSpec, settings: DiagnoseSettings,
         Up to two data-built starts of its hold whose basins fitted best (they
         seed the mechanism fits).
     """
-    x_fits, starts = baseline_starts(rec_train, spec, settings)
+    others: list[np.ndarray] = []
+    x_fits, starts = baseline_starts(rec_train, spec, settings, others=others)
     # a channel with a sensor has dynamics from the start: its hold convention is chosen
     # here, on the training error (a position chain is static until a filter block joins)
     holds = HOLDS if rec_train.channel != 'position' else HOLDS[:1]
+    other = 'falling' if spec.initial == 'rising' else 'rising'
     pairs = [(model, x0) for model in [ComposedModel(rec_train.channel, [], ctx, spec.bounds,
-                                                     hold=h) for h in holds]
-             for x0 in x_fits + starts]
+                                                     hold=h, initial=spec.initial) for h in holds]
+             for x0 in x_fits + starts] + [
+        (ComposedModel(rec_train.channel, [], ctx, spec.bounds, hold=h, initial=other), x0)
+        for h in holds for x0 in others]
     polished = sorted((got + (x0, model) for got, (model, x0) in zip(
         polish_all(pairs, data, 2 * settings.fit_budget, settings.workers), pairs)),
         key=lambda z: z[1])
+    own = [z for z in polished if z[4].initial == spec.initial]
+    if polished[0][4].initial != spec.initial and not _starts_other(
+            evaluate(own[0][4], data, own[0][0]), evaluate(polished[0][4], data, polished[0][0]),
+            data, settings.criteria.bic_drop):
+        polished = own      # the other boundary only where the record's start says so
     best = evaluate(polished[0][4], data, polished[0][0], polished[0][2])
     chain_starts = [z[3] for z in polished if any(z[3] is s for s in starts)
                     and z[4].hold == best.model.hold][:2]
+    if best.model.initial != spec.initial:      # the data-built starts were ranked rising
+        chain_starts = [z[3] for z in own if any(z[3] is s for s in starts)][:2]
     return best, chain_starts
+
+
+def _starts_other(own: FitResult, other: FitResult, data: Data, bic_drop: float) -> bool:
+    """Whether the chain on the other boundary is better for the record's start, clearly.
+
+    The other boundary must fit the training part better by a training BIC of
+    ``bic_drop`` and win at least :data:`START_SHARE` of that gain before the command
+    first sweeps its training range: after that both boundaries give the same
+    chain. A baseline that misses physics can fit the other boundary better by
+    chance, all over the record: the reference simulator's supply decay (a
+    rising start) had switched.
+    """
+    n = data.n_train
+    if not n * np.log(own.sse_train / max(other.sse_train, 1e-300)) > bic_drop:
+        return False
+    v = data.v[:n]
+    lo, hi = float(np.min(v)), float(np.max(v))
+    near = 0.05 * (hi - lo)
+    k = max(int(np.argmax(v <= lo + near)), int(np.argmax(v >= hi - near))) + 1
+    start = float(own.residual[:k] @ own.residual[:k] - other.residual[:k] @ other.residual[:k])
+    return start >= START_SHARE * (own.sse_train - other.sse_train)
 
 
 def challenge(final: FitResult, baseline: FitResult, rec_train: Recording, spec: ChainSpec,

@@ -70,7 +70,7 @@ from hyst_id.diagnosis.refit import contest
 from hyst_id.diagnosis.result import DiagnoseSettings, Diagnosis, Finding
 from hyst_id.diagnosis.select import Comparison, Data, FitResult, round_record
 from hyst_id.diagnosis.split_notes import level_note, range_note, require_split, swing_note
-from hyst_id.diagnosis.start_cut import start_cut
+from hyst_id.diagnosis.start_cut import other_boundary, start_cut
 from hyst_id.diagnosis.ties import alternatives_record, choose, close_calls, hold_calls
 from hyst_id.diagnosis.trial import try_all
 from hyst_id.errors import ConfigError
@@ -222,6 +222,7 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
     say(f'baseline: identify (GAASS x {len(settings.seeds)} seeds, global phase) twice on the '
         f'first {n_train} samples')
     baseline, chain_starts = chain_fit(rec_train, spec, settings, data, ctx)
+    spec, mechs, start_note = other_boundary(baseline.model.initial, spec, mechs)
     floor_h = floor_percent(y[n_train:], sigma)
     floor_t = floor_percent(y[:n_train], sigma)
 
@@ -307,7 +308,8 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
         findings[-1].blocked_cv = blocked.confirm(current, winner.fit)
         current = winner.fit
         loc = relocate(current)
-    notes = list(rec.notes) + range_note(v_orig, n_train, data.judged_rows.size) + chain_notes
+    notes = (list(rec.notes) + [start_note] * bool(start_note)
+             + range_note(v_orig, n_train, data.judged_rows.size) + chain_notes)
     if len(findings) > 1:
         current, dropped = drop_superseded(current, [f.mechanism for f in findings], data,
                                            settings.criteria, max_nfev=2 * settings.fit_budget)
@@ -383,6 +385,7 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
                                              t, v_orig, y, rec.measurement_unit)],
                                          'hold': current.model.hold
                                          if current.model.dynamic else '',
+                                         'initial': current.model.initial,
                                          'judged_holdout': _judged(data, baseline, current)})
 
 

@@ -42,7 +42,7 @@ import numpy as np
 
 from hyst_id.diagnosis.mechanisms.base import Context, Mechanism, STAGES
 from hyst_id.errors import ConfigError
-from hyst_id.identification.chains import chain_spec, HOLDS
+from hyst_id.identification.chains import chain_spec, HOLDS, INITIAL_STATES
 from hyst_id.models.sensors import simulate_first_order, simulate_second_order
 
 __all__ = ['ComposedModel', 'Evaluation', 'held', 'solve_linear']
@@ -98,20 +98,30 @@ class ComposedModel:
         Id of the mechanism that swapped H's family in (listed first in :attr:`ids`).
     hold : {'before', 'after'}, optional
         Zero-order-hold convention of every dynamic element (see the module docstring).
+    initial : {'rising', 'falling'}, optional
+        The boundary of their loops H and B start on (``ChainSpec.initial``); blocks
+        that simulate the actuator themselves (:attr:`Mechanism.stage` ``'actuator'``)
+        start it rising and are not used with a falling start.
     """
 
     def __init__(self, channel: str, mechanisms: Sequence[Mechanism], ctx: Context,
                  chain_bounds: np.ndarray, family: str | None = None,
-                 swapped_by: str = '', hold: str = 'before') -> None:
+                 swapped_by: str = '', hold: str = 'before', initial: str = 'rising') -> None:
         if hold not in HOLDS:
             raise ConfigError(f'hold must be one of {HOLDS}, got {hold!r}')
+        if initial not in INITIAL_STATES:
+            raise ConfigError(f'initial must be one of {INITIAL_STATES}, got {initial!r}')
+        if initial != 'rising' and any(m.stage == 'actuator' for m in mechanisms):
+            raise ConfigError('blocks that simulate the actuator start it rising: '
+                              + ', '.join(m.id for m in mechanisms if m.stage == 'actuator'))
         self.channel = channel
         self.hold = hold
+        self.initial = initial
         self.swapped_by = swapped_by
         self.ctx = ctx
         self.mechanisms = tuple(sorted(mechanisms, key=lambda m: STAGES.index(m.stage)))
-        self.spec = chain_spec(channel, family=family)
-        self.position_spec = chain_spec('position', family=family)
+        self.spec = chain_spec(channel, family=family, initial=initial)
+        self.position_spec = chain_spec('position', family=family, initial=initial)
         self.n_chain = self.spec.n_params
         bounds = [np.asarray(chain_bounds, dtype=float)]
         self.slices: dict[str, slice] = {}

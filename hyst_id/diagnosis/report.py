@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from hyst_id.diagnosis.blocked_cv import confirmed, summary as cv_summary
+from hyst_id.diagnosis.empirical import MIN_GAIN
 from hyst_id.identification.quality import response_warnings
 from hyst_id.io.outputs import names_folder
 
@@ -140,6 +141,9 @@ NEAR_FLOOR = 1.5
 FAR_FROM_FLOOR = 3.0
 #: ... and a whole-record fit within this multiple is close to it.
 WHOLE_RECORD_CLOSE = 2.0
+#: A residual unrelated to the command and correlated over at most this share of the record
+#: reads as coloured noise (:func:`_coloured_lines`).
+COLOURED_SHARE = 0.01
 
 
 def unknown_reading(heldout_x: float, train_x: float, whole_x: float | None,
@@ -197,7 +201,29 @@ def _unknown_lines(d: Any) -> list[str]:
                   if c['status'] == 'training only']
     return unknown_reading(over(d.final.er_holdout_percent, d.noise_floor_percent),
                            over(d.final.er_train_percent, floor_t), whole,
-                           sorted(train_only, key=lambda z: z[1]))
+                           sorted(train_only, key=lambda z: z[1])) + _coloured_lines(d)
+
+
+def _coloured_lines(d: Any) -> list[str]:
+    """An ``unknown`` whose residual looks like coloured measurement noise says so.
+
+    Unrelated to the command (no correlation with it or its rate, no feature of
+    the empirical regression) and correlated over at most :data:`COLOURED_SHARE`
+    of the record: filtered noise or an interference looks so, and the floor,
+    from sample-to-sample changes, is then too low. An independent reviewer's
+    clean records with low-pass noise and mains hum ended ``unknown`` at 1.9 x it.
+    """
+    fl, emp, t = d.final_localization, d.empirical, d.t_s
+    if fl is None or emp is None or emp.gain >= MIN_GAIN or not fl.independent:
+        return []
+    run_s = float(fl.acf['correlated_for_s'])
+    if not 0.0 < run_s <= COLOURED_SHARE * float(t[-1] - t[0]):
+        return []
+    return [f'the residual is unrelated to the command (no correlation with it or its rate, '
+            f'no feature of the empirical regression) and correlated over only {run_s:.2g} s: '
+            'filtered (coloured) measurement noise or an interference looks so, and the noise '
+            'floor, estimated from sample-to-sample changes, is then too low; the miss may be '
+            'the noise itself rather than physics']
 
 
 def _withdrawn_clause(ids: list[str], detail: str = '') -> str:

@@ -36,7 +36,7 @@ effect is diagnosed whole, as before.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -50,7 +50,7 @@ from hyst_id.identification.start_state import left_out_note, refit_start
 from hyst_id.io.recording import Recording
 from hyst_id.signals.split import split_index
 
-__all__ = ['PROBE_NEAR', 'StartCut', 'start_cut']
+__all__ = ['other_boundary', 'PROBE_NEAR', 'StartCut', 'start_cut']
 
 #: The probe from the first reversal must end within this many times its noise floor.
 PROBE_NEAR = 1.3
@@ -111,3 +111,26 @@ def start_cut(rec: Recording, command_model: np.ndarray, spec: ChainSpec,
             + ' (the training part from there, identified without a global phase); '
             'everything below is of the record from there on')
     return StartCut(k, before, after, note)
+
+
+def other_boundary(initial: str, spec: ChainSpec, mechs: list) -> tuple[ChainSpec, list, str]:
+    """The spec and the library for a baseline that starts on the other boundary, and words.
+
+    :func:`hyst_id.diagnosis.challenge.chain_fit` keeps a chain starting on the
+    other boundary of its loops only where the training part says so clearly; the
+    whole diagnosis then runs in it. Blocks that simulate the actuator themselves
+    (stage ``'actuator'``) start it rising and are left out. An independent
+    reviewer's clean record, whose actuator started near its falling edge, was
+    diagnosed rising and claimed an offset drift.
+    """
+    if initial == spec.initial:
+        return spec, mechs, ''
+    left = [m.id for m in mechs if m.stage == 'actuator']
+    note = (f'the chain starts on the {initial} boundary of its loops: its training part '
+            f'fits clearly better so, at its start, than on the {spec.initial} one (as after '
+            f'a command that came {"down from above" if initial == "falling" else "up"} '
+            'before the record), and the whole diagnosis runs so'
+            + (f'; {", ".join(left)}, which start the actuator rising, not tried' if left
+               else ''))
+    return (replace(spec, initial=initial), [m for m in mechs if m.stage != 'actuator'],
+            note)

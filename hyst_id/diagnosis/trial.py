@@ -222,7 +222,8 @@ def try_mechanism(m: Mechanism, current: FitResult, data: Data, ctx: Context,
         for hold in holds:
             model = ComposedModel(ctx.channel, list(prev.mechanisms) + [m], ctx,
                                   prev.bounds[:prev.n_chain], family=prev.spec.family.id,
-                                  swapped_by=prev.swapped_by, hold=hold)
+                                  swapped_by=prev.swapped_by, hold=hold,
+                                  initial=prev.initial)
             p_prev = model.pack(current.p[:prev.n_chain], thetas)
             # the data-built starts are the baseline family's chains
             got = fit_model(model, data, p_prev, m, budget=settings.fit_budget,
@@ -246,7 +247,7 @@ def _as_twin(m: Mechanism, fit: FitResult, current: FitResult, data: Data, ctx: 
     model = ComposedModel(ctx.channel, [m if pm.id == m.fits_as else pm
                                         for pm in prev.mechanisms], ctx,
                           prev.bounds[:prev.n_chain], family=prev.spec.family.id,
-                          swapped_by=prev.swapped_by, hold=prev.hold)
+                          swapped_by=prev.swapped_by, hold=prev.hold, initial=prev.initial)
     return judge(m, current, evaluate(model, data, fit.p, fit.nfev), data, ctx, settings, loc)
 
 
@@ -292,10 +293,10 @@ def _swap_family(m: Mechanism, current: FitResult, data: Data, ctx: Context,
     """
     prev, fam, n = current.model, m.swap_family, data.n_train
     rec_train = Recording(data.t_s[:n], data.v[:n], data.y[:n], ctx.channel)
-    spec = domains_from_data(rec_train, family=fam)
+    spec = replace(domains_from_data(rec_train, family=fam), initial=prev.initial)
     keep = [pm for pm in prev.mechanisms if pm.families is None or fam in pm.families]
     model = ComposedModel(ctx.channel, keep, ctx, spec.bounds, family=fam, swapped_by=m.id,
-                          hold=prev.hold)
+                          hold=prev.hold, initial=prev.initial)
     x_fits, starts = quick_starts(rec_train, spec, settings)
     best = None
     for x0 in x_fits + starts:

@@ -51,3 +51,24 @@ def test_without_a_judged_part_nothing_is_said():
     d = _d('creep', 10.0)
     d.extra = {}
     assert _left_over(d) == []
+
+
+def _unknown(run_s: float, independent: bool = True, gain: float = 0.0):
+    import numpy as np
+    return SimpleNamespace(
+        t_s=np.arange(3000) * 0.01, empirical=SimpleNamespace(gain=gain),
+        final_localization=SimpleNamespace(independent=independent,
+                                           acf={'correlated_for_s': run_s}))
+
+
+@pytest.mark.parametrize('run_s, independent, gain, said', [
+    (0.1, True, 0.0, True), (0.29, True, 0.0, True), (0.4, True, 0.0, False),
+    (0.1, False, 0.0, False), (0.1, True, 0.2, False), (0.0, True, 0.0, False)])
+def test_an_unknown_that_looks_like_coloured_noise_says_so(run_s, independent, gain, said):
+    """Unrelated to the command and correlated over at most 1 % of the record."""
+    from hyst_id.diagnosis.report import _coloured_lines
+    words = _coloured_lines(_unknown(run_s, independent, gain))
+    assert bool(words) == said, words
+    if said:
+        assert f'correlated over only {run_s:.2g} s: filtered (coloured) measurement noise' \
+               in words[0] and 'the miss may be the noise itself rather than physics' in words[0]
