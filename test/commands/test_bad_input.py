@@ -76,34 +76,30 @@ def wrong_type_bag(tmp: Path) -> Path:
     return path
 
 
-def clock_jump_bag(tmp: Path) -> Path:
-    """Header stamps set back 5 s from message 400 on (a clock reset), log times in order."""
-    path = tmp / 'clock_jump'
-    cfg = TopicConfig.for_channel('position')
-    with BagWriter(path) as writer:
-        writer.add_topic(cfg.command_topic, 'std_msgs/msg/Float64')
-        writer.add_topic(cfg.measurement_topic, cfg.measurement_type)
-        for i, t in enumerate(T):
-            t_ns = int(1e18 + t * 1e9)
-            stamp = t_ns - (5 * 10**9 if i >= 400 else 0)
-            writer.write(cfg.command_topic, t_ns, {'data': float(V[i])})
-            writer.write(cfg.measurement_topic, t_ns + 1000,
-                         {'header': {'stamp': stamp}, 'position': [float(Y[i])]})
-    return path
-
-
-def zero_stamp_bag(tmp: Path) -> Path:
-    """Every message stamped 0 (header and log time): reading keeps one sample."""
-    path = tmp / 'zero_stamps'
+def _stamped_bag(path: Path, log_ns: np.ndarray, stamp_ns: np.ndarray) -> Path:
+    """Command and header-stamped measurement, message ``i`` logged at ``log_ns[i]``."""
     cfg = TopicConfig.for_channel('position')
     with BagWriter(path) as writer:
         writer.add_topic(cfg.command_topic, 'std_msgs/msg/Float64')
         writer.add_topic(cfg.measurement_topic, cfg.measurement_type)
         for i in range(T.size):
-            writer.write(cfg.command_topic, 0, {'data': float(V[i])})
-            writer.write(cfg.measurement_topic, 0, {'header': {'stamp': 0},
-                                                    'position': [float(Y[i])]})
+            writer.write(cfg.command_topic, int(log_ns[i]), {'data': float(V[i])})
+            writer.write(cfg.measurement_topic, int(log_ns[i]), {
+                'header': {'stamp': int(stamp_ns[i])}, 'position': [float(Y[i])]})
     return path
+
+
+def clock_jump_bag(tmp: Path) -> Path:
+    """Header stamps set back 5 s from message 400 on (a clock reset), log times in order."""
+    log_ns = (10**18 + np.round(T * 1e9)).astype(np.int64)
+    return _stamped_bag(tmp / 'clock_jump', log_ns,
+                        log_ns - np.where(np.arange(T.size) >= 400, 5 * 10**9, 0))
+
+
+def zero_stamp_bag(tmp: Path) -> Path:
+    """Every message stamped 0 (header and log time): reading keeps one sample."""
+    zeros = np.zeros(T.size, dtype=np.int64)
+    return _stamped_bag(tmp / 'zero_stamps', zeros, zeros)
 
 
 def no_topics_bag(tmp: Path) -> Path:
