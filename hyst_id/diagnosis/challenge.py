@@ -114,13 +114,14 @@ def chain_fit(rec_train: Recording, spec: ChainSpec, settings: DiagnoseSettings,
         polish_all(pairs, data, 2 * settings.fit_budget, settings.workers), pairs)),
         key=lambda z: z[1])
     own = [z for z in polished if z[4].initial == spec.initial]
-    if polished[0][4].initial != spec.initial and not _starts_other(
-            evaluate(own[0][4], data, own[0][0]), evaluate(polished[0][4], data, polished[0][0]),
-            evaluate(ComposedModel(rec_train.channel, [], ctx, spec.bounds, hold=own[0][4].hold,
-                                   initial=other), data, own[0][0]),
-            data, settings.criteria.bic_drop):
-        polished = own      # the other boundary only where the record's start says so
     best = evaluate(polished[0][4], data, polished[0][0], polished[0][2])
+    if best.model.initial != spec.initial:
+        mine = evaluate(own[0][4], data, own[0][0], own[0][2])
+        as_other = ComposedModel(rec_train.channel, [], ctx, spec.bounds, hold=own[0][4].hold,
+                                 initial=other)
+        if not _starts_other(mine, best, evaluate(as_other, data, own[0][0]), data,
+                             settings.criteria.bic_drop):
+            best, polished = mine, own  # the other boundary only where the start says so
     chain_starts = [z[3] for z in polished if any(z[3] is s for s in starts)
                     and z[4].hold == best.model.hold][:2]
     if best.model.initial != spec.initial:      # the data-built starts were ranked rising

@@ -460,8 +460,9 @@ def _refresh_values(findings: list[Finding], mechs: list[Mechanism], final: FitR
             continue
         own = dict(info, er_before=f.er_holdout_before_percent,   # its round's, as reported
                    er_after=f.er_holdout_after_percent)
-        f.params = m.describe(final.model.theta(final.p, m.id), final.coef, own, ctx)
-        f.at_edges = m.at_edges(final.model.theta(final.p, m.id), ctx)
+        theta = final.model.theta(final.p, m.id)
+        f.params = m.describe(theta, final.coef, own, ctx)
+        f.at_edges = m.at_edges(theta, ctx)
         f.explanation = m.explain(f.params, f.where, ctx)
         f.compensation['how'] = m.compensation_note(f.params, ctx)
 

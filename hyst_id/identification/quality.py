@@ -235,7 +235,7 @@ def fit_warnings(ident: Identification) -> list[str]:
                    'response; look at the residual plot')
     elif floor > 0 and ident.er_percent > FIT_FACTOR * floor:
         hint = ('; curved branches (a piezo stack, a ferrite core, a Bouc-Wen loop) are the '
-                "smooth family's: try --model auto" if getattr(ident, 'family', 'tk') == 'tk'
+                "smooth family's: try --model auto" if ident.family == 'tk'
                 else '')
         hint += ('; a measurement that follows the command with a lag has sensor dynamics '
                  'the position chain lacks: try --channel pressure (a first-order sensor) or '
