@@ -339,7 +339,8 @@ def _bag_file(path: Path) -> tuple[Path, list[str]]:
 
 
 @contextmanager
-def open_bag(path: str | Path, *, recover_truncated: bool = False) -> Iterator[BagContents]:
+def open_bag(path: str | Path, *, recover_truncated: bool = False,
+             remedy: str = 'recover_truncated=True') -> Iterator[BagContents]:
     """Open a rosbag2 bag (directory or single ``.mcap`` file) for reading.
 
     Parameters
@@ -350,6 +351,9 @@ def open_bag(path: str | Path, *, recover_truncated: bool = False) -> Iterator[B
     recover_truncated : bool
         When the MCAP file has no footer (writer killed), read the complete
         chunks instead of raising.
+    remedy : str
+        How the caller's user asks for that, named in the error of a truncated
+        bag (a node's parameter is ``-p recover_truncated:=true``).
 
     Yields
     ------
@@ -379,7 +383,7 @@ def open_bag(path: str | Path, *, recover_truncated: bool = False) -> Iterator[B
                 return
             raise TruncatedBagError(
                 f'cannot read bag {path}: {failure} (no MCAP footer: truncated, or the '
-                f'recorder was killed; recover_truncated=True reads its complete chunks)')
+                f'recorder was killed; {remedy} reads its complete chunks)')
         raise RecordingError(f'cannot read bag {path}: {failure}')
     try:
         topics: dict[str, str] = {}

@@ -42,7 +42,7 @@ from builtin_interfaces.msg import Time
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock
 
-from hyst_id.errors import ConfigError, HystIdError, RecordingError, TruncatedBagError
+from hyst_id.errors import ConfigError, HystIdError, RecordingError
 from hyst_id.io.bag import default_typestore, iter_bag_messages, open_bag
 from hyst_id.nodes.support import (
     HystNode,
@@ -91,17 +91,14 @@ class Replay(HystNode):
             raise ConfigError('replay: set the bag parameter (-p bag:=PATH)')
         self.path = Path(self.p('bag')).expanduser()
         selected = [t for t in self.p('topics') if t]
-        try:
-            with open_bag(self.path, recover_truncated=self.p('recover_truncated')) as bag:
-                available = dict(bag.topics)
-                counts = dict(bag.counts)
-                latched = set(bag.latched)
-                if selected and selected != ['*']:
-                    bag.check_topics(selected)
-                    available = {t: available[t] for t in selected}
-        except TruncatedBagError as exc:     # the remedy as a node's parameter is spelled
-            raise TruncatedBagError(str(exc).replace(
-                'recover_truncated=True', '-p recover_truncated:=true')) from None
+        with open_bag(self.path, recover_truncated=self.p('recover_truncated'),
+                      remedy='-p recover_truncated:=true') as bag:
+            available = dict(bag.topics)
+            counts = dict(bag.counts)
+            latched = set(bag.latched)
+            if selected and selected != ['*']:
+                bag.check_topics(selected)
+                available = {t: available[t] for t in selected}
         self._topics = available
         self._typestore = default_typestore()
         self._pubs = {}
