@@ -70,6 +70,7 @@ import json
 from pathlib import Path
 import sys
 import time
+from typing import Callable
 
 import numpy as np
 
@@ -105,11 +106,18 @@ def draw_excitation(rng: np.random.Generator, t: np.ndarray) -> tuple[str, np.nd
     return kind, _excitation(kind, t, rng)
 
 
-def draw(index: int, only: frozenset | None = None) -> dict:
+def draw(index: int, only: frozenset | None = None, initial: str = 'rising',
+         noise: Callable[[np.random.Generator, int, float, float], np.ndarray] | None = None
+         ) -> dict:
     """Recording ``index``: command, measurement, the effects and their magnitudes.
 
     ``only``: apply only these of its effects (the others are drawn, so that
     everything else is the same, but left out): what one effect alone costs.
+    ``initial``: the boundary the reference chain starts on (the family's is
+    ``'rising'``; ``bench/start_shares.py`` draws it ``'falling'`` too).
+    ``noise``: ``noise(rng, n, sigma, dt_s)`` gives the measurement noise of standard
+    deviation ``sigma`` instead of white Gaussian noise
+    (``bench/coloured_noise_family.py``).
     """
     rng = np.random.default_rng([index, 14])
     channel = ('position', 'pressure')[index % 2]
@@ -130,7 +138,7 @@ def draw(index: int, only: frozenset | None = None) -> dict:
         mags['dead_time'] = d * dt
     if 'dead_time' in on:
         vv = np.concatenate([np.full(d, v[0]), v[:-d]])
-    x = reference_simulate('position', p, t, vv)
+    x = reference_simulate('position', p, t, vv, initial=initial)
     span = float(np.ptp(x))
     if 'saturation' in effects:
         cut = _logu(rng, 0.02, 0.25)
@@ -177,7 +185,7 @@ def draw(index: int, only: frozenset | None = None) -> dict:
     if 'offset_drift' in on:
         y = y + r * span * t / t[-1]
     sigma = rng.uniform(0.002, 0.01) * span
-    y = y + rng.normal(0.0, sigma, y.size)
+    y = y + (rng.normal(0.0, sigma, y.size) if noise is None else noise(rng, y.size, sigma, dt))
     a, b = float(np.exp(rng.uniform(np.log(0.5), np.log(5.0)))), float(rng.uniform(-5, 5))
     k = float(np.exp(rng.uniform(np.log(0.1), np.log(100.0))))
     zero = rng.uniform(-10, 10) * k       # the reading of y = 0 (gain_drift's pivot)

@@ -59,7 +59,8 @@ from hyst_id.io.recording import Recording
 if TYPE_CHECKING:
     from hyst_id.diagnosis.result import DiagnoseSettings
 
-__all__ = ['CHALLENGE_FACTOR', 'chain_fit', 'challenge', 'START_SHARE', 'withdrawn_note']
+__all__ = ['CHALLENGE_FACTOR', 'chain_fit', 'challenge', 'START_SHARE', 'start_evidence',
+           'withdrawn_note']
 
 #: Share of the other boundary's training gain that must lie before the command first sweeps
 #: its training range, where the two boundaries differ (:func:`chain_fit`).
@@ -141,20 +142,42 @@ def _starts_other(own: FitResult, other: FitResult, own_as_other: FitResult, dat
     start better on the other boundary too. A baseline that misses physics can fit
     the other boundary better by chance, over the whole record: the reference
     simulator's supply decay and the package's own synthetic one (rising starts)
-    had switched with the start taken as the first sweep of the whole range; the
-    synthetic one won 41 % of its gain at the start so defined, the falling starts
-    of ``test_start_boundary.py`` and a reviewer's record 80-98 %.
+    had switched with the start taken as the first sweep of the whole range.
+    ``python bench/start_shares.py`` prints the shares (:func:`start_evidence`) over
+    records started on either boundary.
+    """
+    bic_gain, share, meets = start_evidence(own, other, own_as_other, data)
+    return bic_gain > bic_drop and share >= START_SHARE and meets
+
+
+def start_evidence(own: FitResult, other: FitResult, own_as_other: FitResult,
+                   data: Data) -> tuple[float, float, bool]:
+    """What :func:`_starts_other` weighs: the BIC gain, the start's share of it, the own chain.
+
+    Returns
+    -------
+    bic_gain : float
+        ``n_train * log(own.sse_train / other.sse_train)``: the training BIC the other
+        boundary gains (the parameter counts are the same).
+    share : float
+        The part of the training gain in squared error won before the command has first
+        swept half its training range, over the whole training gain (nan when there is
+        no gain).
+    meets : bool
+        Whether ``own_as_other`` (the own chain's values, started on the other boundary)
+        meets that start better than the own chain does.
     """
     n = data.n_train
-    if not n * np.log(own.sse_train / max(other.sse_train, 1e-300)) > bic_drop:
-        return False
+    bic_gain = float(n * np.log(own.sse_train / max(other.sse_train, 1e-300)))
     v = data.v[:n]
     swept = np.maximum.accumulate(v) - np.minimum.accumulate(v)
     k = int(np.argmax(swept >= 0.5 * float(np.ptp(v)))) + 1
     own_start = float(own.residual[:k] @ own.residual[:k])
     start = own_start - float(other.residual[:k] @ other.residual[:k])
     again = float(own_as_other.residual[:k] @ own_as_other.residual[:k])
-    return start >= START_SHARE * (own.sse_train - other.sse_train) and again < own_start
+    gain = own.sse_train - other.sse_train
+    share = start / gain if gain > 0 else float('nan')
+    return bic_gain, share, again < own_start
 
 
 def challenge(final: FitResult, baseline: FitResult, rec_train: Recording, spec: ChainSpec,
