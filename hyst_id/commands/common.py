@@ -86,6 +86,10 @@ def add_settings_arguments(parser: argparse.ArgumentParser, identify: bool = Tru
                    'reversal and the part before it is left out when that fits clearly better')
     if not identify:
         return
+    g.add_argument('--proper-loops', action='store_true',
+                   help='search proper loops only (those the compensator can invert); by '
+                   "default a fit left above the floor is tried again over the paper's wider "
+                   'set, loops whose output jumps at some reversals (docs/model.md)')
     g.add_argument('--c', type=float, default=0.007, help='search-space contraction rate')
     g.add_argument('--xi', type=float, default=0.02, help='mutation subspace coefficient')
     g.add_argument('--er-bound', type=float, default=None,
@@ -253,7 +257,7 @@ def make_settings(args: argparse.Namespace) -> IdentifySettings:
         refine=not args.gaass_only, restarts=args.restarts, er_bound_percent=args.er_bound,
         global_evals=args.global_evals, global_runs=args.global_runs, hops=args.hops,
         search_samples=args.search_samples, more_starts=args.more_starts,
-        start_state=not args.whole_record)
+        start_state=not args.whole_record, loose_loops=not getattr(args, 'proper_loops', False))
 
 
 def make_spec(args: argparse.Namespace, rec: Recording, family: str | None = None) -> ChainSpec:

@@ -99,6 +99,10 @@ def run(args: argparse.Namespace) -> int:
     if args.plot:
         for path in plot_identification(ident, rec, args.plot):
             print(f'wrote {path}', file=sys.stderr)
+    if args.params_out and not ident.proper:
+        raise ConfigError(f'{args.params_out} not written: the loop identified is not proper '
+                          '(see the first warning), and the compensator has no exact inverse of '
+                          'it; --proper-loops identifies the best proper loop')
     if args.params_out:
         from hyst_id.compensation.params_file import command_limits_for, write_compensator_params
         limits = command_limits_for(rec.command)

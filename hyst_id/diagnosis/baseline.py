@@ -62,7 +62,7 @@ def identify_base(settings) -> dict:
     return {'pop_size': settings.pop_size, 'maxiter': settings.generations,
             'seeds': tuple(settings.seeds), 'workers': settings.workers, 'refine': True,
             'refine_top': 2, 'restarts': 1, 'refine_max_nfev': 1500, 'hops': settings.hops,
-            'start_state': False}
+            'start_state': False, 'loose_loops': False}
 
 
 def baseline_starts(rec_train: Recording, spec: ChainSpec, settings, *, thorough: bool = True,

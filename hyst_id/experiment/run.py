@@ -406,7 +406,7 @@ def run_experiment(params_path=None, *, settings: IdentifySettings | None = None
     ExperimentResult
     """
     # the paper's procedure fits the whole run (no start-state retry)
-    settings = replace(settings or IdentifySettings(), start_state=False)
+    settings = replace(settings or IdentifySettings(), start_state=False, loose_loops=False)
     if seeds is not None:
         seeds = tuple(range(seeds)) if isinstance(seeds, int) else tuple(int(s) for s in seeds)
         settings = replace(settings, seeds=seeds)

@@ -98,9 +98,9 @@ PAPER_DOMAINS = {**dict(get_family(DEFAULT_FAMILY).paper_domains), **TAIL_PAPER_
 
 
 def _rows_feasible(family: HysteresisFamily, h: np.ndarray, tail: np.ndarray,
-                   paper_frame: bool) -> np.ndarray:
+                   paper_frame: bool, proper: bool = True) -> np.ndarray:
     """Every constraint per row: H's family, B's and the sensor's, the paper's frame-bound ones."""
-    ok = family.feasible_rows(h) & tail_feasible_rows(tail)
+    ok = (family.feasible_rows(h) if proper else family.loose_rows(h)) & tail_feasible_rows(tail)
     return ok & family.paper_frame_rows(h) if paper_frame else ok
 
 
@@ -145,6 +145,11 @@ class ChainSpec:
         held over the interval before it (the default: the command changed
         right after the previous sample) or after it (a sample is taken just
         before the command of its instant acts; so do some simulators).
+    proper : bool
+        Search and validate proper loops only (the default; the inverse needs
+        them). ``False``: the family's wider set (:meth:`~hyst_id.models.family.
+        HysteresisFamily.loose_rows`; for the paper's loop, its own constraints,
+        output jumps admitted), searched by :mod:`~hyst_id.identification.loose_phase`.
     """
 
     channel: str
@@ -155,6 +160,7 @@ class ChainSpec:
     family: HysteresisFamily = field(default_factory=lambda: get_family(DEFAULT_FAMILY))
     initial: str = 'rising'
     hold: str = 'before'
+    proper: bool = True
 
     def __post_init__(self) -> None:
         if self.initial not in INITIAL_STATES:
@@ -227,7 +233,8 @@ class ChainSpec:
         pop = np.ascontiguousarray(np.atleast_2d(pop), dtype=np.float64)
         nh = self.n_h
         return _rows_feasible(self.family, np.ascontiguousarray(pop[:, :nh]),
-                              np.ascontiguousarray(pop[:, nh:]), self.domain_source == 'paper')
+                              np.ascontiguousarray(pop[:, nh:]), self.domain_source == 'paper',
+                              self.proper)
 
     def cost_function(self, t_s: np.ndarray, command: np.ndarray,
                       measurement: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
@@ -241,7 +248,7 @@ class ChainSpec:
         nh, family = self.n_h, self.family
         block = max(1, _BLOCK_VALUES // max(1, v.shape[0]))
         v_h, falling, hold_after = self._h_command(v), self.falling, self.hold == 'after'
-        paper_frame = self.domain_source == 'paper'
+        paper_frame, proper = self.domain_source == 'paper', self.proper
 
         def cost(pop: np.ndarray) -> np.ndarray:
             pop = np.ascontiguousarray(np.atleast_2d(pop), dtype=np.float64)
@@ -250,7 +257,7 @@ class ChainSpec:
                 rows = pop[a:a + block]
                 h = np.ascontiguousarray(rows[:, :nh])
                 tail = np.ascontiguousarray(rows[:, nh:])
-                ok = _rows_feasible(family, h, tail, paper_frame)
+                ok = _rows_feasible(family, h, tail, paper_frame, proper)
                 u = np.empty((rows.shape[0], v_h.shape[0]))
                 family.simulate_rows(h, v_h, ok, u)
                 if falling:
@@ -333,7 +340,10 @@ class ChainSpec:
                 f'{self.names}, got {p.shape[0]}')
         if not np.all(np.isfinite(p)):
             raise InvalidParametersError('parameters must be finite')
-        self.family.check(p[:self.n_h])
+        if self.proper:
+            self.family.check(p[:self.n_h])
+        else:
+            self.family.check_simulable(p[:self.n_h])
         check_backlash(p[self.backlash_slice])
         sensor = p[self.sensor_slice]
         if self.channel == 'pressure' and sensor[0] < 0:

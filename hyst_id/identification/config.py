@@ -55,7 +55,7 @@ def make_settings(*, seeds: int = 10, seed_offset: int = 0, pop_size: int = 10,
                   er_bound_percent: float | None = None,
                   global_evals: int = 200000, global_runs: int = 14, hops: int = 100,
                   search_samples: int = 20000, more_starts: bool = False,
-                  start_state: bool = True) -> IdentifySettings:
+                  start_state: bool = True, loose_loops: bool = True) -> IdentifySettings:
     """GAASS and refinement settings (the paper's by default), checked.
 
     Raises
@@ -91,7 +91,7 @@ def make_settings(*, seeds: int = 10, seed_offset: int = 0, pop_size: int = 10,
         er_bound_percent=er_bound_percent, global_evals=int(global_evals),
         global_runs=int(global_runs), hops=int(hops),
         search_samples=int(search_samples), more_starts=bool(more_starts),
-        start_state=bool(start_state))
+        start_state=bool(start_state), loose_loops=bool(loose_loops))
 
 
 def read_domains_file(path: str) -> dict[str, tuple[float, float]]:

@@ -44,6 +44,7 @@ from hyst_id.identification.incumbent import (
     rank_conventions,
     search_subset,
 )
+from hyst_id.identification.loose_phase import loose_retry
 from hyst_id.identification.quality import assess
 from hyst_id.identification.refine import refine
 from hyst_id.identification.result import Identification, IdentifySettings, SeedRun
@@ -261,10 +262,18 @@ def identify(recording: Recording, *, spec: ChainSpec | None = None,
 
 def _identify(rec: Recording, spec: ChainSpec | None, settings: IdentifySettings | None,
               progress, on_generation, should_stop) -> Identification:
-    """:func:`identify` of a validated recording, as it is."""
+    """:func:`identify` of a validated recording, as it is: proper loops, then maybe loose ones."""
     rec = roundoff_probe(rec)
     settings = settings or IdentifySettings()
     spec = spec or domains_from_data(rec)
+    ident = _identify_chain(rec, spec, settings, progress, on_generation, should_stop)
+    return loose_retry(ident, spec, settings, lambda loose, plain: _identify_chain(
+        rec, loose, plain, progress, on_generation, should_stop))
+
+
+def _identify_chain(rec: Recording, spec: ChainSpec, settings: IdentifySettings,
+                    progress, on_generation, should_stop) -> Identification:
+    """:func:`identify` in one chain's constraint set."""
     if spec.channel != rec.channel:
         raise IdentificationError(
             f'chain is for {spec.channel!r} but the recording is {rec.channel!r}')
@@ -354,7 +363,7 @@ def summarise(rec: Recording, spec: ChainSpec, settings: IdentifySettings,
     # the chain is the best run's: its initial state and sensor hold
     spec = replace(spec, initial=best.initial, hold=best.hold)
     canon = replace(chain_spec(rec.channel, calibration=(best.sign, 0.0), family=spec.family),
-                    initial=spec.initial, hold=spec.hold)
+                    initial=spec.initial, hold=spec.hold, proper=spec.proper)
     warnings = []
     same_chain = [r for r in runs if (r.initial, r.hold) == (best.initial, best.hold)]
     if len(same_chain) < len(runs):
@@ -378,4 +387,4 @@ def summarise(rec: Recording, spec: ChainSpec, settings: IdentifySettings,
         noise_floor_percent=noise_floor_percent(rec.measurement),
         runs=runs, bounds=spec.bounds, domain_source=spec.domain_source,
         settings=settings, warnings=warnings, source=rec.source, family=spec.family.id,
-        initial=spec.initial, hold=spec.hold)
+        initial=spec.initial, hold=spec.hold, proper=spec.proper)

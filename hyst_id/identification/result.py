@@ -129,6 +129,14 @@ class IdentifySettings:
         actuator that starts inside its play). Off in the paper's experiment
         (the paper fits the whole run) and in a diagnosis's baseline (judged
         on the whole record; its blind-family figures were measured without).
+    loose_loops : bool
+        With refinement on, when every proper search ends between ``global_factor``
+        and :data:`~hyst_id.identification.loose_phase.LOOSE_WITHIN` x the floor:
+        search the paper's constraint set too, loops whose output jumps at some
+        reversals (:mod:`hyst_id.identification.loose_phase`), and keep such a loop
+        only when it fits clearly better. Off in the paper's experiment, a
+        diagnosis's baseline and the live identifier (their sets feed H⁻¹, which
+        needs a proper loop).
     """
 
     pop_size: int = 10
@@ -154,6 +162,7 @@ class IdentifySettings:
     search_samples: int = 20000
     more_starts: bool = False
     start_state: bool = True
+    loose_loops: bool = True
 
 
 @dataclass
@@ -238,6 +247,9 @@ class Identification:
     initial: str = 'rising'
     hold: str = 'before'
     other_nfev: int = 0
+    #: False when the loop that fits is one the paper's constraints admit but a proper
+    #: loop's corner order does not (:mod:`hyst_id.identification.loose_phase`).
+    proper: bool = True
 
     @property
     def nfev(self) -> int:
@@ -253,7 +265,8 @@ class Identification:
         """Chain spec that simulates the canonical parameters (calibration sign, 0)."""
         return replace(chain_spec(self.channel, calibration=(self.output_sign, 0.0),
                                   family=self.family, initial=self.initial),
-                       hold=self.hold).with_bounds(self.bounds, source=self.domain_source)
+                       hold=self.hold, proper=self.proper).with_bounds(
+            self.bounds, source=self.domain_source)
 
     def to_dict(self) -> dict:
         """JSON-ready summary (arrays as lists)."""
@@ -265,6 +278,7 @@ class Identification:
         return {
             'channel': self.channel, 'family': self.family, 'source': self.source,
             'initial_state': self.initial, 'sensor_hold': self.hold,
+            'proper_loop': self.proper,
             'params': self.params, 'params_mean': self.params_mean,
             'output_sign': self.output_sign,
             'calibration': {'k': self.output_sign, 'b': 0.0,

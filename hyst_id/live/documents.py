@@ -53,6 +53,10 @@ def compensator_set(ident: Identification) -> tuple[dict | None, float, str]:
     try:
         InverseModel.from_mapping(best)
     except InvalidParametersError as exc:
+        if not getattr(ident, 'proper', True):
+            return None, float('nan'), (
+                f'the identified loop is not proper ({exc}): the compensator has no exact '
+                'inverse of it; nothing is handed to the compensator')
         return None, float('nan'), (
             f'the identified set is not a valid compensator model ({exc}); nothing is handed '
             'to the compensator (please report this: canonical sets should always be valid)')

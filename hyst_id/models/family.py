@@ -168,6 +168,18 @@ class HysteresisFamily:
         """
         raise NotImplementedError
 
+    def loose_rows(self, pop: np.ndarray) -> np.ndarray:
+        """A wider search set than :meth:`feasible_rows`, where the family has one.
+
+        Default: the same rows. The paper's loop admits loops whose output jumps
+        (:meth:`hyst_id.models.tk.TaoKokotovic.loose_rows`).
+        """
+        return self.feasible_rows(pop)
+
+    def check_simulable(self, params: np.ndarray) -> np.ndarray:
+        """Validate a set for simulation (of :meth:`loose_rows`); default :meth:`check`."""
+        return self.check(params)
+
     def paper_frame_rows(self, pop: np.ndarray) -> np.ndarray:
         """Constraints of the paper that hold only in its command frame (mA), per row.
 

@@ -183,7 +183,7 @@ def loop_corners(params: np.ndarray) -> dict[str, tuple[float, float]]:
             'C': (v_c, m_t * v_c + c_t), 'D': (v_d, m_t * v_d + c_t)}
 
 
-def check_hysteresis(params: np.ndarray) -> np.ndarray:
+def check_hysteresis(params: np.ndarray, proper: bool = True) -> np.ndarray:
     """Return ``params`` as float64, or raise if they do not describe a proper loop.
 
     The checks are gauge invariant (:func:`loop_is_proper`), so they hold for
@@ -194,6 +194,10 @@ def check_hysteresis(params: np.ndarray) -> np.ndarray:
     ----------
     params : array_like
         ``(m_l, m_r, m_t, m_b, c_l, c_r, c_t, c_b)``.
+    proper : bool
+        Require the corner order of a proper loop (the inverse needs it); without
+        it only the slopes are checked: a set the step rule can simulate, as the
+        paper's constraints admit (:meth:`TaoKokotovic.check_simulable`).
 
     Raises
     ------
@@ -213,7 +217,7 @@ def check_hysteresis(params: np.ndarray) -> np.ndarray:
     for ok, rule in checks:
         if not ok:
             raise InvalidParametersError(f'hysteresis parameters violate {rule}')
-    if not loop_is_proper(m_l, m_r, m_t, m_b, c_l, c_r, c_t, c_b):
+    if proper and not loop_is_proper(m_l, m_r, m_t, m_b, c_l, c_r, c_t, c_b):
         corners = {k: round(float(v[0]), 4) for k, v in loop_corners(p).items()}
         raise InvalidParametersError(
             'hysteresis loop is not proper: the left line must stay left of the right line '
@@ -275,7 +279,11 @@ def invert_hysteresis(params: np.ndarray, desired: np.ndarray, v0: float,
 
 
 @njit(cache=True)
-def _feasible_rows(pop):
+def _feasible_rows(pop, proper):
+    """Per row: finite and a proper loop with ``c_l < c_r``, or (not ``proper``) the paper's set.
+
+    The paper's set: slopes and ``c_l < c_r``, the corners in any order.
+    """
     ok = np.empty(pop.shape[0], dtype=np.bool_)
     for i in range(pop.shape[0]):
         p = pop[i]
@@ -283,7 +291,14 @@ def _feasible_rows(pop):
         for q in range(8):
             if not np.isfinite(p[q]):
                 good = False
-        ok[i] = good and hysteresis_feasible(p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7])
+        m_min = min(p[0], p[1])
+        if not good:
+            ok[i] = False
+        elif proper:
+            ok[i] = hysteresis_feasible(p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7])
+        else:
+            ok[i] = (p[0] > 0.0 and p[1] > 0.0 and 0.0 < p[2] < m_min
+                     and 0.0 < p[3] < m_min and p[4] < p[5])
     return ok
 
 
@@ -373,7 +388,21 @@ class TaoKokotovic(HysteresisFamily):
 
     def feasible_rows(self, pop: np.ndarray) -> np.ndarray:
         """``c_l < c_r`` and a proper loop, per row (any command frame)."""
-        return _feasible_rows(np.ascontiguousarray(pop, dtype=np.float64))
+        return _feasible_rows(np.ascontiguousarray(pop, dtype=np.float64), True)
+
+    def loose_rows(self, pop: np.ndarray) -> np.ndarray:
+        """The paper's constraints only, per row: loops whose output jumps are admitted.
+
+        With the corners out of order (the left line meeting the bottom or the top
+        line right of where the right line does) the step rule jumps at some
+        reversals; an independent simulator of the paper's equations draws such
+        loops, so :mod:`hyst_id.identification.loose_phase` searches them too.
+        """
+        return _feasible_rows(np.ascontiguousarray(pop, dtype=np.float64), False)
+
+    def check_simulable(self, params: np.ndarray) -> np.ndarray:
+        """Validate for simulation only: the slopes, the corners in any order."""
+        return check_hysteresis(params, proper=False)
 
     def paper_frame_rows(self, pop: np.ndarray) -> np.ndarray:
         """The paper's ``c_t > c_b`` (top above bottom at command 0), per row."""

@@ -77,14 +77,19 @@ def validate_identifier_params(values: dict[str, Any], changed: set[str]) -> str
 
 
 def identify_settings(p: Callable[[str], Any]) -> IdentifySettings:
-    """Identify's settings from the node's parameters (``p(name)``), as the CLI builds them."""
+    """Identify's settings from the node's parameters (``p(name)``), as the CLI builds them.
+
+    Proper loops only (``--proper-loops``): the node's sets go to the compensator,
+    which inverts proper loops only.
+    """
     bound = p('er_bound_percent')
     return make_settings(
         seeds=p('seeds'), seed_offset=p('seed_offset'), pop_size=p('pop_size'),
         generations=p('generations'), c=p('c'), xi=p('xi'), workers=p('workers'),
         refine=p('refine'), restarts=p('restarts'),
         er_bound_percent=bound if bound > 0 else None, global_evals=p('global_evals'),
-        global_runs=p('global_runs'), hops=p('hops'), more_starts=p('more_starts'))
+        global_runs=p('global_runs'), hops=p('hops'), more_starts=p('more_starts'),
+        loose_loops=False)
 
 
 def default_params_out() -> Path:

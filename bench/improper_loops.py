@@ -1,0 +1,160 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""Chains drawn under the paper's constraints only: whether identify reaches the noise floor.
+
+The package searches proper loops first (corners in order, ``docs/model.md``);
+the paper's constraints admit loops whose corners are out of order, whose
+output jumps at some reversals, and an independent simulator drawing its
+parameters under the paper's constraints makes them often. This draws random
+chains that way (slopes ``m_l, m_r`` 0.6-1.6, ``m_t, m_b`` 5-60 % of the
+smaller; the side lines crossing zero output near command 0, ``c_l`` within 1
+of it and ``c_r`` 0.1-0.6 command half ranges above, as in the paper's domains;
+the paper's ``v_2`` (left line meets bottom) 0.3-0.9 half ranges below the
+command's centre and ``v_1`` (right line meets top) 0.3-1.2 above; ``c_t > c_b``;
+a backlash; the pressure sensor's lag 0.2-2 s, the
+flow sensor's damping 0.3-0.9 and 1-4 rad/s), simulates them with the
+independent reference simulator (``test/reference_sim``) under the excitations
+of ``bench/generalisation.py`` (1,500 samples, 0.05 s, Gaussian noise 0.3-1.5 %
+of the span) and identifies each with the defaults. It prints, per recording,
+whether the true loop is proper, the fit's %e_r over the true noise (1.0: the
+floor) and over the estimated floor, whether the loop kept is proper, and the
+seconds; then the counts. Run from the repository root (1-4 minutes per
+recording and worker)::
+
+    python bench/improper_loops.py [--n 12] [--workers 2] [--without-loose]
+
+``--without-loose``: the proper search alone (``IdentifySettings.loose_loops``
+off), as before the loose phase.
+"""
+
+from __future__ import annotations
+
+import argparse
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import replace
+from pathlib import Path
+import sys
+import time
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / 'bench'))
+sys.path.insert(0, str(ROOT / 'test'))
+sys.path.insert(0, str(ROOT))
+
+from generalisation import _excitation, EXCITATIONS  # noqa: E402, I100
+from reference_sim import simulate as reference_simulate  # noqa: E402, I100
+
+from hyst_id.identification import identify, IdentifySettings  # noqa: E402, I100
+from hyst_id.io.recording import Recording  # noqa: E402
+from hyst_id.models.tk import loop_is_proper  # noqa: E402
+
+CHANNELS = ('position', 'pressure', 'flow')
+N_SAMPLES, DT_S = 1500, 0.05
+
+
+def paper_chain(rng: np.random.Generator, v: np.ndarray, channel: str) -> dict:
+    """Random chain parameters under the paper's constraints only (corners in any order)."""
+    lo, hi = float(v.min()), float(v.max())
+    vc, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
+    while True:
+        m_l, m_r = rng.uniform(0.6, 1.6, 2)
+        m_t, m_b = rng.uniform(0.05, 0.6, 2) * min(m_l, m_r)
+        # the side lines cross zero output near command 0, as in the paper's domains
+        c_l = rng.uniform(-1.0, 1.0)
+        c_r = c_l + rng.uniform(0.1, 0.6) * half
+        # the paper's v_2 (left line meets bottom) and v_1 (right line meets top) in range
+        v_2 = vc - rng.uniform(0.3, 0.9) * half
+        v_1 = vc + rng.uniform(0.3, 1.2) * half
+        c_b = m_l * (v_2 - c_l) - m_b * v_2
+        c_t = m_r * (v_1 - c_r) - m_t * v_1
+        if c_t > c_b:
+            break
+    width = rng.uniform(0.02, 0.3) * half * min(m_l, m_r)
+    p = {'m_l': m_l, 'm_r': m_r, 'm_t': m_t, 'm_b': m_b, 'c_l': c_l, 'c_r': c_r, 'c_t': c_t,
+         'c_b': c_b, 'm_bl': rng.uniform(0.7, 1.5), 'c_bl': -width, 'c_br': width}
+    if channel == 'pressure':
+        p['tau_s'] = rng.uniform(0.2, 2.0)
+    if channel == 'flow':
+        p['zeta'], p['omega_n'] = rng.uniform(0.3, 0.9), rng.uniform(1.0, 4.0)
+    return p
+
+
+def draw(index: int) -> dict:
+    """Recording ``index``: channel, excitation, truth, command, measurement, noise std."""
+    rng = np.random.default_rng([index, 63])
+    channel = CHANNELS[index % 3]
+    t = np.arange(N_SAMPLES) * DT_S
+    kind = EXCITATIONS[int(rng.integers(0, len(EXCITATIONS)))]
+    v = _excitation(kind, t, rng)
+    p = paper_chain(rng, v, channel)
+    x = reference_simulate(channel, p, t, v)
+    sigma = rng.uniform(0.003, 0.015) * float(np.ptp(x))
+    h_names = ('m_l', 'm_r', 'm_t', 'm_b', 'c_l', 'c_r', 'c_t', 'c_b')
+    proper = bool(loop_is_proper(*(p[k] for k in h_names)))
+    return {'index': index, 'channel': channel, 'excitation': kind, 'params': p,
+            'proper': proper, 't': t, 'command': v,
+            'measurement': x + rng.normal(0.0, sigma, x.size), 'sigma': sigma}
+
+
+def one(job: tuple[int, bool]) -> dict:
+    """Identify recording ``index`` (``loose``: the defaults; else the proper search alone)."""
+    index, loose = job
+    case = draw(index)
+    rec = Recording(case['t'], case['command'], case['measurement'], case['channel'])
+    t0 = time.monotonic()
+    settings = IdentifySettings(workers=1)
+    ident = identify(rec, settings=settings if loose else replace(settings, loose_loops=False))
+    y = rec.measurement
+    rms = ident.er_percent / 100.0 * float(np.sqrt(np.mean(y ** 2)))
+    return {'index': index, 'channel': case['channel'], 'excitation': case['excitation'],
+            'true_proper': case['proper'], 'kept_proper': ident.proper,
+            'over_noise': rms / case['sigma'],
+            'over_floor': ident.er_percent / ident.noise_floor_percent,
+            'seconds': time.monotonic() - t0}
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Identify the drawn recordings and print the table and the counts."""
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument('--n', type=int, default=12)
+    ap.add_argument('--indices', type=int, nargs='*', help='these recordings instead')
+    ap.add_argument('--workers', type=int, default=2)
+    ap.add_argument('--without-loose', action='store_true')
+    args = ap.parse_args(argv)
+    indices = args.indices if args.indices else list(range(args.n))
+    with ProcessPoolExecutor(args.workers) as pool:
+        rows = list(pool.map(one, [(i, not args.without_loose) for i in indices]))
+    print('  #  channel   excitation      true loop  kept loop  x true noise  x est. floor'
+          '  seconds')
+    for r in rows:
+        print(f'#{r["index"]:3d} {r["channel"]:9s} {r["excitation"]:15s} '
+              f'{"proper" if r["true_proper"] else "improper":9s}  '
+              f'{"proper" if r["kept_proper"] else "improper":9s}  {r["over_noise"]:12.3f}  '
+              f'{r["over_floor"]:12.3f}  {r["seconds"]:7.0f}')
+    for truth in (True, False):
+        mine = [r for r in rows if r['true_proper'] == truth]
+        if mine:
+            ratios = sorted(r['over_noise'] for r in mine)
+            print(f'{"proper" if truth else "improper"} truths: {len(mine)}; within 1.1 x the '
+                  f'true noise {sum(x <= 1.1 for x in ratios)}, within 1.5 x '
+                  f'{sum(x <= 1.5 for x in ratios)}; median {np.median(ratios):.3f}, worst '
+                  f'{ratios[-1]:.3f}; kept improper {sum(not r["kept_proper"] for r in mine)}')
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())

@@ -1,0 +1,111 @@
+# Copyright 2026 The hyst_id authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""The loose phase of :func:`~hyst_id.identification.driver.identify`: loops whose output jumps.
+
+The package searches *proper* loops (the corner order of ``docs/model.md``:
+the left line meets the bottom and the top lines left of where the right line
+does), because only on those is H⁻¹ an exact inverse. The paper's constraints
+(``m_l, m_r > 0``, ``min(m_l, m_r) > m_t, m_b > 0``, ``c_l < c_r``) admit more:
+loops whose corners are out of order, on which the same step rule makes the
+output jump at some reversals. An independent simulator of the paper's
+equations that draws its parameters under the paper's constraints makes such
+loops often (most of an independent reviewer's random chains), and the proper
+search then stopped well above the noise floor where a plain CMA-ES over the
+paper's set reached it (``bench/improper_loops.py --without-loose``).
+
+So when the proper identification ends above ``settings.global_factor`` x the
+floor but within :data:`LOOSE_WITHIN` x of it, it runs again over the paper's
+set (:attr:`ChainSpec.proper` false: the seeds, hopping and the global phase),
+and the loose fit is kept only when its %e_r is below :data:`LOOSE_GAIN` times
+the proper one's. Its first warning then says the loop is not proper, where its
+corners are and that the compensator refuses it (``check_hysteresis``: H⁻¹ is
+no exact inverse of a loop that jumps). ``python bench/improper_loops.py``
+prints what it does on proper and improper chains of the reference simulator.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from typing import Callable
+
+from hyst_id.identification.chains import ChainSpec
+from hyst_id.identification.result import Identification, IdentifySettings
+from hyst_id.models.tk import loop_corners, loop_is_proper
+
+__all__ = ['improper_words', 'LOOSE_GAIN', 'LOOSE_WITHIN', 'loose_retry']
+
+#: The loose search runs only when the proper fit ends within this multiple of the floor:
+#: further off, the misfit is physics the chain lacks (the shared real recordings end at
+#: 44-108 x, ``bench/real_recordings.py``).
+LOOSE_WITHIN = 20.0
+
+#: A loose fit is kept when its %e_r is below this share of the proper fit's.
+LOOSE_GAIN = 0.8
+
+
+def loose_retry(ident: Identification, spec: ChainSpec, settings: IdentifySettings,
+                run: Callable[[ChainSpec, IdentifySettings], Identification]
+                ) -> Identification:
+    """``ident``, or the identification over the paper's wider set when it fits clearly better.
+
+    Parameters
+    ----------
+    ident : Identification
+        The identification over proper loops.
+    spec : ChainSpec
+        The chain it searched (proper).
+    settings : IdentifySettings
+        ``loose_loops`` (off: ``ident`` as it is), ``refine``, ``global_factor``.
+    run : callable
+        ``run(spec, settings)`` identifies again in another chain spec.
+
+    Returns
+    -------
+    Identification
+        The loose identification (its ``proper`` false, a warning first) when it
+        beats :data:`LOOSE_GAIN` x ``ident``'s %e_r; else ``ident``, with the loose
+        search's evaluations counted in ``other_nfev``.
+    """
+    floor = ident.noise_floor_percent
+    if (not settings.loose_loops or not settings.refine or spec.family.id != 'tk'
+            or not spec.proper or settings.global_runs <= 0 or settings.global_evals <= 0
+            or not settings.global_factor * floor < ident.er_percent <= LOOSE_WITHIN * floor):
+        return ident
+    loose = run(replace(spec, proper=False), replace(settings, loose_loops=False))
+    if not loose.er_percent < LOOSE_GAIN * ident.er_percent:
+        ident.other_nfev += loose.nfev
+        return ident
+    loose.other_nfev += ident.nfev
+    words = improper_words(loose, ident.er_percent / floor)
+    if words:
+        loose.warnings.insert(0, words)
+    return loose
+
+
+def improper_words(ident: Identification, proper_ratio: float) -> str:
+    """What a loop outside the proper set means, or '' for a proper one."""
+    h = [ident.params[n] for n in ident.names[:8]]
+    if loop_is_proper(*h):
+        return ''
+    corners = {k: v[0] for k, v in loop_corners(h).items()}
+    out = [f'{a} {corners[a]:.4g} > {b} {corners[b]:.4g}'
+           for a, b in (('A', 'B'), ('D', 'C'), ('A', 'D'), ('B', 'C')) if corners[a] > corners[b]]
+    return (f'the loop that fits is not a proper one: no proper loop came below '
+            f"{proper_ratio:.2f} x the noise floor, and the paper's constraints admit loops "
+            f'whose corners are out of order (command at the corners: {", ".join(out)}; '
+            'A, D: the left line at the bottom and top lines, B, C: the right line). The '
+            "paper's step rule makes such a loop's output jump at reversals between those "
+            'corners, as another simulator of its equations may, or an actuator that snaps. '
+            'H^-1 is not an exact inverse of it: the compensator refuses this set')
