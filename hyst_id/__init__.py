@@ -20,6 +20,7 @@ The public API, as rosbags and pysindy expose theirs (details in ``docs/api.md``
 
     rec = read_recording('run.mcap', 'position')        # or a CSV
     ident = identify(rec)                                # -> Identification
+    # ident.proper False: a loop whose output jumps, which no inverse cancels
     diag = diagnose(rec)                                 # -> Diagnosis
     comp = Compensator(InverseModel.from_mapping(dict(ident.params,
                                                       output_sign=ident.output_sign)))

@@ -256,7 +256,8 @@ def identify(recording: Recording, *, spec: ChainSpec | None = None,
     restart('GAASS seeds, from the first reversal')
     again = _identify(rest, spec, full, progress, on_generation, should_stop)
     after = again.er_percent / again.noise_floor_percent   # > 0: the probe's was
-    again.warnings.insert(0, left_out_note(rec.t_s, k, before, after))
+    # after an improper loop's warning, which the CLI's --params-out refusal points to
+    again.warnings.insert(0 if again.proper else 1, left_out_note(rec.t_s, k, before, after))
     return again
 
 

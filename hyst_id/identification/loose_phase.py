@@ -91,6 +91,8 @@ def loose_retry(ident: Identification, spec: ChainSpec, settings: IdentifySettin
     words = improper_words(loose, ident.er_percent / floor)
     if words:
         loose.warnings.insert(0, words)
+    else:   # the wider search found a better proper loop: nothing to refuse
+        loose.proper = True
     return loose
 
 

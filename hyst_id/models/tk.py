@@ -480,12 +480,12 @@ class TaoKokotovic(HysteresisFamily):
     def unexcited(self, params: np.ndarray, command: np.ndarray,
                   command_unit: str = '') -> tuple[list[str], set[str]]:
         """Lines of the loop the command never drives H along (see :mod:`.tk_lines`)."""
-        try:
-            p = check_hysteresis(np.asarray(params, dtype=float)[:8])
+        try:    # an improper loop (the loose phase's) has lines too
+            p = check_hysteresis(np.asarray(params, dtype=float)[:8], proper=False)
         except InvalidParametersError:
             return [], set()
-        return unexcited_lines(p, command, self.simulate(p, command), loop_corners(p),
-                               command_unit)
+        return unexcited_lines(p, command, self.simulate(p, command, validate=False),
+                               loop_corners(p), command_unit)
 
     def describe(self, params: np.ndarray) -> dict[str, float]:
         """Corner commands and outputs of the major loop, and its width at mid height."""

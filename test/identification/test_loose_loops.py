@@ -39,6 +39,7 @@ from hyst_id.identification.chains import chain_spec
 from hyst_id.identification.loose_phase import LOOSE_GAIN, loose_retry, LOOSE_WITHIN
 from hyst_id.identification.result import Identification
 from hyst_id.io.recording import Recording
+from hyst_id.models.registry import get_family
 from hyst_id.models.tk import check_hysteresis, loop_corners, loop_is_proper
 
 #: A chain drawn as ``bench/improper_loops.py`` draws (its recording 9): the left line meets
@@ -123,6 +124,22 @@ def test_a_loose_fit_is_kept_only_when_clearly_better_and_says_so():
         return replace(_ident(3.0 * LOOSE_GAIN * 1.01), proper=False)
     same = loose_retry(_ident(3.0), chain_spec('position'), IdentifySettings(), barely)
     assert same.proper and same.er_percent == 3.0 and same.other_nfev == 7 + 7
+
+
+def test_a_loose_search_that_finds_a_better_proper_loop_reports_it_proper():
+    proper_set = [1.01, 1.05, 0.10, 0.15, -0.25, 0.50, 14.0, 7.0, 1.0, -0.15, 0.15]
+    assert loop_is_proper(*proper_set[:8])
+
+    def found_proper(spec, plain):
+        return replace(_ident(1.0, params=proper_set), proper=False)
+    kept = loose_retry(_ident(3.0), chain_spec('position'), IdentifySettings(), found_proper)
+    assert kept.proper and kept.er_percent == 1.0 and not kept.warnings
+
+
+def test_the_lines_an_improper_loop_never_reaches_are_still_said():
+    v = 9.0 + 0.3 * np.sin(np.linspace(0.0, 20.0, 400))     # a small loop in the middle
+    words, names = get_family('tk').unexcited(np.array(H), v)
+    assert words and names
 
 
 def _recording(seed: int) -> tuple[Recording, float]:
