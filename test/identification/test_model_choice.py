@@ -22,6 +22,7 @@ piecewise-linear one (``reference_sim``, written apart from hyst_id) to
 
 from __future__ import annotations
 
+from dataclasses import replace
 import json
 from pathlib import Path
 import subprocess
@@ -58,7 +59,10 @@ def _tk_recording(seed: int) -> Recording:
 @pytest.mark.parametrize('seed', [0, pytest.param(1, marks=pytest.mark.thorough)])
 def test_a_curved_loop_goes_to_the_smooth_family(seed):
     rec, _ = smooth_recording(seed)
-    choice = choose_family(rec, settings=SETTINGS)
+    # the tk fit of a curved loop ends a few times above its floor, where identify also
+    # searches loops that jump (the loose phase, test_loose_loops.py): a minute more here
+    # for what this test does not ask
+    choice = choose_family(rec, settings=replace(SETTINGS, loose_loops=False))
     scores = {s.family: s.holdout_er_percent for s in choice.scores}
     assert choice.chosen == 'smooth', scores
     assert choice.identification.family == 'smooth'
