@@ -56,6 +56,7 @@ __all__ = [
     'hysteresis_feasible',
     'loop_corners',
     'loop_is_proper',
+    'slopes_admitted',
     'initial_output',
     'hysteresis_step',
     'hysteresis_inverse_step',
@@ -70,6 +71,13 @@ UNITS = {'m_l': 'out/cmd', 'm_r': 'out/cmd', 'm_t': 'out/cmd', 'm_b': 'out/cmd',
 #: The paper's search domains (section 4).
 PAPER_DOMAINS = {'m_l': (0.0, 5.0), 'm_r': (0.0, 5.0), 'm_t': (0.0, 5.0), 'm_b': (0.0, 5.0),
                  'c_l': (-5.0, 5.0), 'c_r': (-5.0, 5.0), 'c_t': (4.0, 20.0), 'c_b': (4.0, 20.0)}
+
+
+@njit(cache=True, inline='always')
+def slopes_admitted(m_l, m_r, m_t, m_b):
+    """The paper's slope constraints: ``m_l, m_r > 0``, ``min(m_l, m_r) > m_t, m_b > 0``."""
+    m_min = min(m_l, m_r)
+    return m_l > 0.0 and m_r > 0.0 and 0.0 < m_t < m_min and 0.0 < m_b < m_min
 
 
 @njit(cache=True, inline='always')
@@ -90,8 +98,7 @@ def loop_is_proper(m_l, m_r, m_t, m_b, c_l, c_r, c_t, c_b):
     compares where the lines extrapolate to zero output and is a
     search-space constraint (:func:`hysteresis_feasible`).
     """
-    m_min = min(m_l, m_r)
-    if not (m_l > 0.0 and m_r > 0.0 and 0.0 < m_t < m_min and 0.0 < m_b < m_min):
+    if not slopes_admitted(m_l, m_r, m_t, m_b):
         return False
     v_a = (c_b + m_l * c_l) / (m_l - m_b)
     v_b = (c_b + m_r * c_r) / (m_r - m_b)
@@ -291,14 +298,12 @@ def _feasible_rows(pop, proper):
         for q in range(8):
             if not np.isfinite(p[q]):
                 good = False
-        m_min = min(p[0], p[1])
         if not good:
             ok[i] = False
         elif proper:
             ok[i] = hysteresis_feasible(p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7])
         else:
-            ok[i] = (p[0] > 0.0 and p[1] > 0.0 and 0.0 < p[2] < m_min
-                     and 0.0 < p[3] < m_min and p[4] < p[5])
+            ok[i] = slopes_admitted(p[0], p[1], p[2], p[3]) and p[4] < p[5]
     return ok
 
 

@@ -83,6 +83,13 @@ def test_the_compensator_refuses_an_improper_loop_in_words():
         InverseModel.from_vector(X, 1.0, 'tk')
 
 
+def test_a_diagnosis_baseline_searches_proper_loops_only():
+    from hyst_id.diagnosis.baseline import identify_base
+    from hyst_id.diagnosis.result import DiagnoseSettings
+    assert IdentifySettings().loose_loops
+    assert IdentifySettings(**identify_base(DiagnoseSettings())).loose_loops is False
+
+
 def _ident(er: float, floor: float = 1.0, params: list | None = None) -> Identification:
     spec = chain_spec('position')
     x = params if params is not None else list(X)

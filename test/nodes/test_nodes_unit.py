@@ -739,3 +739,10 @@ def test_a_resubscription_does_not_record_a_latched_message_twice(ctx, tmp_path)
     rec.close()
     rows = list(iter_bag_messages(tmp_path / 'bag', topics=['/params']))
     assert [m.data for _, _, _, m in rows] == ['first']
+
+
+def test_the_identifier_node_searches_proper_loops_only():
+    # its sets go to the compensator, which inverts proper loops only (test_loose_loops.py)
+    from hyst_id.nodes.support.identifier_params import identify_settings, PARAMS
+    defaults = {q.name: q.default for q in PARAMS}
+    assert identify_settings(defaults.__getitem__).loose_loops is False
