@@ -388,4 +388,4 @@ def summarise(rec: Recording, spec: ChainSpec, settings: IdentifySettings,
         noise_floor_percent=noise_floor_percent(rec.measurement),
         runs=runs, bounds=spec.bounds, domain_source=spec.domain_source,
         settings=settings, warnings=warnings, source=rec.source, family=spec.family.id,
-        initial=spec.initial, hold=spec.hold, proper=spec.proper)
+        initial=spec.initial, hold=spec.hold)

@@ -42,7 +42,7 @@ from typing import Callable
 
 from hyst_id.identification.chains import ChainSpec
 from hyst_id.identification.result import Identification, IdentifySettings
-from hyst_id.models.tk import loop_corners, loop_is_proper
+from hyst_id.models.tk import loop_corners
 
 __all__ = ['improper_words', 'LOOSE_GAIN', 'LOOSE_WITHIN', 'loose_retry']
 
@@ -74,7 +74,7 @@ def loose_retry(ident: Identification, spec: ChainSpec, settings: IdentifySettin
     Returns
     -------
     Identification
-        The loose identification (its ``proper`` false, a warning first) when it
+        The loose identification (a warning first when its loop is not proper) when it
         beats :data:`LOOSE_GAIN` x ``ident``'s %e_r; else ``ident``, with the loose
         search's evaluations counted in ``other_nfev``.
     """
@@ -89,18 +89,16 @@ def loose_retry(ident: Identification, spec: ChainSpec, settings: IdentifySettin
         return ident
     loose.other_nfev += ident.nfev
     words = improper_words(loose, ident.er_percent / floor)
-    if words:
+    if words:   # none when the wider search found a better proper loop
         loose.warnings.insert(0, words)
-    else:   # the wider search found a better proper loop: nothing to refuse
-        loose.proper = True
     return loose
 
 
 def improper_words(ident: Identification, proper_ratio: float) -> str:
     """What a loop outside the proper set means, or '' for a proper one."""
-    h = [ident.params[n] for n in ident.names[:8]]
-    if loop_is_proper(*h):
+    if ident.proper:
         return ''
+    h = [ident.params[n] for n in ident.names[:8]]
     corners = {k: v[0] for k, v in loop_corners(h).items()}
     out = [f'{a} {corners[a]:.4g} > {b} {corners[b]:.4g}'
            for a, b in (('A', 'B'), ('D', 'C'), ('A', 'D'), ('B', 'C')) if corners[a] > corners[b]]

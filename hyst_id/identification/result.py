@@ -27,6 +27,7 @@ from dataclasses import asdict, dataclass, field, replace
 import numpy as np
 
 from hyst_id.identification.chains import chain_spec, ChainSpec
+from hyst_id.models.tk import loop_is_proper
 
 __all__ = ['IdentifySettings', 'SeedRun', 'Identification']
 
@@ -247,9 +248,17 @@ class Identification:
     initial: str = 'rising'
     hold: str = 'before'
     other_nfev: int = 0
-    #: False when the loop that fits is one the paper's constraints admit but a proper
-    #: loop's corner order does not (:mod:`hyst_id.identification.loose_phase`).
-    proper: bool = True
+
+    @property
+    def proper(self) -> bool:
+        """Whether the loop is proper: False for one only the paper's wider set admits.
+
+        Such a loop's corners are out of a proper loop's order
+        (:mod:`hyst_id.identification.loose_phase`); other families are always proper.
+        """
+        if self.family != 'tk':
+            return True
+        return bool(loop_is_proper(*(float(self.params[n]) for n in self.names[:8])))
 
     @property
     def nfev(self) -> int:

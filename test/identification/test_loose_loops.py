@@ -90,9 +90,14 @@ def test_a_diagnosis_baseline_searches_proper_loops_only():
     assert IdentifySettings(**identify_base(DiagnoseSettings())).loose_loops is False
 
 
+#: A proper loop (the paper's induced hysteresis with a small backlash).
+PROPER = [1.01, 1.05, 0.10, 0.15, -0.25, 0.50, 14.0, 7.0, 1.0, -0.15, 0.15]
+
+
 def _ident(er: float, floor: float = 1.0, params: list | None = None) -> Identification:
+    """A stand-in result (proper loop unless ``params`` say otherwise)."""
     spec = chain_spec('position')
-    x = params if params is not None else list(X)
+    x = params if params is not None else PROPER
     return Identification(channel='position', names=spec.names,
                           params=dict(zip(spec.names, x)), params_mean={}, output_sign=1.0,
                           er_percent=er, er_mean_params_percent=er,
@@ -112,7 +117,7 @@ def test_the_loose_search_runs_only_above_the_floor_and_within_reach(er, setting
 
     def run(spec, plain):
         calls.append((spec.proper, plain.loose_loops))
-        return _ident(er)
+        return _ident(er, params=list(X))
     loose_retry(_ident(er), chain_spec('position'), settings, run)
     assert calls == ([(False, False)] if runs else [])
 
@@ -121,24 +126,23 @@ def test_a_loose_fit_is_kept_only_when_clearly_better_and_says_so():
     proper_fit = _ident(3.0)
 
     def better(spec, plain):
-        return replace(_ident(1.0), proper=False)
+        return _ident(1.0, params=list(X))
     kept = loose_retry(proper_fit, chain_spec('position'), IdentifySettings(), better)
     assert not kept.proper and kept.other_nfev == 7 + 7
     assert kept.warnings[0].startswith('the loop that fits is not a proper one')
     assert 'A 7.86 > B 7.35' in kept.warnings[0] and 'compensator refuses' in kept.warnings[0]
 
     def barely(spec, plain):
-        return replace(_ident(3.0 * LOOSE_GAIN * 1.01), proper=False)
+        return _ident(3.0 * LOOSE_GAIN * 1.01, params=list(X))
     same = loose_retry(_ident(3.0), chain_spec('position'), IdentifySettings(), barely)
     assert same.proper and same.er_percent == 3.0 and same.other_nfev == 7 + 7
 
 
 def test_a_loose_search_that_finds_a_better_proper_loop_reports_it_proper():
-    proper_set = [1.01, 1.05, 0.10, 0.15, -0.25, 0.50, 14.0, 7.0, 1.0, -0.15, 0.15]
-    assert loop_is_proper(*proper_set[:8])
+    assert loop_is_proper(*PROPER[:8])
 
     def found_proper(spec, plain):
-        return replace(_ident(1.0, params=proper_set), proper=False)
+        return _ident(1.0, params=PROPER)
     kept = loose_retry(_ident(3.0), chain_spec('position'), IdentifySettings(), found_proper)
     assert kept.proper and kept.er_percent == 1.0 and not kept.warnings
 
