@@ -36,7 +36,12 @@ recording and worker)::
     python bench/improper_loops.py [--n 12] [--workers 2] [--without-loose]
 
 ``--without-loose``: the proper search alone (``IdentifySettings.loose_loops``
-off), as before the loose phase.
+off), as before the loose phase. ``--test-record SEEDS``: instead, the recording of
+``test/identification/test_loose_loops.py`` with these noise seeds, each
+unperturbed and under round-off probes 1 and 2 (``HYST_ID_ROUNDOFF_PROBE``:
+another CPU's last bits), and the ratio its tests bound (``rms / sigma < 1.2``)::
+
+    python bench/improper_loops.py --test-record 0 1 2 3 4 5
 """
 
 from __future__ import annotations
@@ -44,6 +49,7 @@ from __future__ import annotations
 import argparse
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import replace
+import os
 from pathlib import Path
 import sys
 import time
@@ -127,6 +133,19 @@ def one(job: tuple[int, bool]) -> dict:
             'seconds': time.monotonic() - t0}
 
 
+def test_record(job: tuple[int, str]) -> tuple[int, str, float, bool, float]:
+    """The test's recording with noise ``seed`` under probe ``probe``: its bounded ratio."""
+    seed, probe = job
+    sys.path.insert(0, str(ROOT / 'test' / 'identification'))
+    from test_loose_loops import _recording
+    os.environ['HYST_ID_ROUNDOFF_PROBE'] = probe
+    rec, sigma = _recording(seed)
+    t0 = time.monotonic()
+    ident = identify(rec, settings=IdentifySettings(workers=1))
+    rms = ident.er_percent / 100.0 * float(np.sqrt(np.mean(rec.measurement ** 2)))
+    return seed, probe or '-', rms / sigma, ident.proper, time.monotonic() - t0
+
+
 def main(argv: list[str] | None = None) -> int:
     """Identify the drawn recordings and print the table and the counts."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -134,7 +153,20 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument('--indices', type=int, nargs='*', help='these recordings instead')
     ap.add_argument('--workers', type=int, default=2)
     ap.add_argument('--without-loose', action='store_true')
+    ap.add_argument('--test-record', type=int, nargs='+', metavar='SEED',
+                    help="the tests' recording with these noise seeds, under probes too")
     args = ap.parse_args(argv)
+    if args.test_record:
+        with ProcessPoolExecutor(args.workers) as pool:
+            got = list(pool.map(test_record, [(s, pr) for s in args.test_record
+                                              for pr in ('', '1', '2')]))
+        print('seed  probe  rms / sigma  kept loop  seconds')
+        for seed, probe, ratio, proper, sec in got:
+            print(f'{seed:4d}  {probe:5s}  {ratio:11.3f}  {"proper" if proper else "improper":9s}'
+                  f'  {sec:7.0f}')
+        print(f'rms / sigma: {min(g[2] for g in got):.3f} - {max(g[2] for g in got):.3f} over '
+              f'{len(got)} runs; kept improper in {sum(not g[3] for g in got)}')
+        return 0
     indices = args.indices if args.indices else list(range(args.n))
     with ProcessPoolExecutor(args.workers) as pool:
         rows = list(pool.map(one, [(i, not args.without_loose) for i in indices]))

@@ -153,6 +153,12 @@ def test_the_lines_an_improper_loop_never_reaches_are_still_said():
     assert words and names
 
 
+#: ``python bench/improper_loops.py --test-record 0 1 2 3 4 5``: rms / sigma 0.973-1.144 over
+#: noise seeds 0-5, each unperturbed and under round-off probes 1 and 2 (18 runs, every one
+#: kept improper); the proper search alone ends near 5.5 x on this chain (the bench's #9).
+RATIO_BOUND = 1.3
+
+
 def _recording(seed: int) -> tuple[Recording, float]:
     """The improper chain under a decaying sine, 1,500 samples, noise 1 % of the span."""
     t = np.arange(1500) * 0.05
@@ -170,7 +176,7 @@ def test_identify_reaches_the_floor_on_an_improper_loop():
     rms = ident.er_percent / 100 * float(np.sqrt(np.mean(rec.measurement ** 2)))
     assert not ident.proper
     assert ident.warnings[0].startswith('the loop that fits is not a proper one')
-    assert rms / sigma < 1.2
+    assert rms / sigma < RATIO_BOUND
 
 
 @pytest.mark.slow
@@ -189,5 +195,5 @@ def test_the_cli_reports_an_improper_loop_and_writes_no_compensator_file(tmp_pat
     doc = json.loads(result.read_text())
     assert doc['proper_loop'] is False
     rms = doc['er_percent'] / 100 * float(np.sqrt(np.mean(rec.measurement ** 2)))
-    assert rms / sigma < 1.2
+    assert rms / sigma < RATIO_BOUND
     assert 'not a proper one' in out.out
