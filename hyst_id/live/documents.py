@@ -53,7 +53,7 @@ def compensator_set(ident: Identification) -> tuple[dict | None, float, str]:
     try:
         InverseModel.from_mapping(best)
     except InvalidParametersError as exc:
-        if not ident.proper:
+        if not getattr(ident, 'proper', True):   # callers pass stand-ins without it
             return None, float('nan'), (
                 f'the identified loop is not proper ({exc}): the compensator has no exact '
                 'inverse of it; nothing is handed to the compensator')
