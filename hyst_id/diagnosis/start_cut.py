@@ -43,6 +43,7 @@ import numpy as np
 from hyst_id.diagnosis.baseline import identify_base
 from hyst_id.diagnosis.result import DiagnoseSettings
 from hyst_id.diagnosis.split_notes import MIN_HELDOUT_SAMPLES, MIN_TRAIN_SAMPLES
+from hyst_id.errors import NoExcitationError
 from hyst_id.identification import identify, IdentifySettings
 from hyst_id.identification.chains import ChainSpec
 from hyst_id.identification.quality import FIT_FACTOR
@@ -97,9 +98,12 @@ def start_cut(rec: Recording, command_model: np.ndarray, spec: ChainSpec,
         return None     # the record from there is too short to diagnose (require_split)
     part = Recording(rest_t[:n_train], command_model[k:k + n_train],
                      rec.measurement[k:k + n_train], rec.channel, source=rec.source)
-    probe = identify(part, spec=spec, settings=IdentifySettings(**{
-        **identify_base(settings), 'seeds': tuple(settings.seeds)[:2], 'hops': 0,
-        'global_runs': 0}), should_stop=settings.should_stop)
+    try:
+        probe = identify(part, spec=spec, settings=IdentifySettings(**{
+            **identify_base(settings), 'seeds': tuple(settings.seeds)[:2], 'hops': 0,
+            'global_runs': 0}), should_stop=settings.should_stop)
+    except NoExcitationError:
+        return None     # from its first reversal on, the record no longer excites the loop
     if not probe.noise_floor_percent > 0:
         return None
     before = er_train_percent / floor_train_percent

@@ -31,7 +31,12 @@ from play_reference import rest_then_sine
 import pytest
 
 from hyst_id.diagnosis import diagnose, DiagnoseSettings
-from hyst_id.diagnosis.start_cut import PROBE_NEAR
+from hyst_id.diagnosis.start_cut import PROBE_NEAR, start_cut
+from hyst_id.identification.domains import domains_from_data
+from hyst_id.io.recording import Recording
+from hyst_id.signals.excitation import multisine
+from hyst_id.signals.reversals import reversal_indices
+from hyst_id.signals.split import split_index
 
 SETTINGS = DiagnoseSettings(workers=1, hops=20)
 
@@ -101,7 +106,6 @@ def test_no_cut_leaves_a_record_too_short_to_diagnose(monkeypatch):
     """
     import hyst_id.diagnosis.start_cut as start_cut_module
     from hyst_id.identification.chains import chain_spec
-    from hyst_id.io.recording import Recording
 
     def no_probe(*args, **kwargs):
         raise AssertionError('the probe ran')
@@ -116,3 +120,24 @@ def test_no_cut_leaves_a_record_too_short_to_diagnose(monkeypatch):
         else:
             assert start_cut_module.start_cut(rec, v, chain_spec('position'), SETTINGS,
                                               3.0, 1.0) is None
+
+
+def test_a_part_that_no_longer_reverses_twice_gives_no_cut():
+    """The probe's training part from the first reversal may not excite the loop.
+
+    A 10 s multisine reverses three times, but the training part of the record
+    from its first reversal on reverses once; ``diagnose`` raised ``NoExcitationError`` from
+    the probe (saying the command reverses once) for a record it could
+    diagnose.
+    """
+    t = np.arange(0.0, 10.0, 0.05)
+    v = multisine(t, amplitude_ma=1.8)
+    rec = Recording(t, v, 0.5 * v + np.random.default_rng(0).normal(0.0, 0.005, t.size),
+                    'position')
+    spec = domains_from_data(rec)
+    index, _ = reversal_indices(v)
+    k = int(index[0])
+    n_train = split_index(t[k:], SETTINGS.train_fraction)
+    assert index.size >= 3 and reversal_indices(v[k:k + n_train])[0].size < 2
+    assert start_cut(rec, v, spec, SETTINGS, er_train_percent=5.0,
+                     floor_train_percent=0.1) is None
