@@ -36,12 +36,20 @@ recording and worker)::
     python bench/improper_loops.py [--n 12] [--workers 2] [--without-loose]
 
 ``--without-loose``: the proper search alone (``IdentifySettings.loose_loops``
-off), as before the loose phase. ``--test-record SEEDS``: instead, the recording of
+off), as before the loose phase. ``--diagnose``: ``hyst-id diagnose`` (the
+defaults, one worker) instead of identify, each recording being clean (noise
+only, so every claimed block is a false claim): verdict, blocks, final held-out
+%e_r over the floor and whether the loop it ends with is proper;
+``--without-loose`` then turns the diagnosis's loose baseline off
+(``DiagnoseSettings.loose_loops``, :mod:`hyst_id.diagnosis.loose_baseline`).
+``--test-record SEEDS``: instead, the recording of
 ``test/identification/test_loose_loops.py`` with these noise seeds, each
 unperturbed and under round-off probes 1 and 2 (``HYST_ID_ROUNDOFF_PROBE``:
-another CPU's last bits), and the ratio its tests bound (``rms / sigma < 1.2``)::
+another CPU's last bits), and the ratio its tests bound (``rms / sigma``); with
+``--diagnose``, of ``test/diagnosis/test_loose_baseline.py`` (the final held-out
+%e_r over the floor, and the verdict)::
 
-    python bench/improper_loops.py --test-record 0 1 2 3 4 5
+    python bench/improper_loops.py --test-record 0 1 2 3 4 5 [--diagnose]
 """
 
 from __future__ import annotations
@@ -133,17 +141,61 @@ def one(job: tuple[int, bool]) -> dict:
             'seconds': time.monotonic() - t0}
 
 
-def test_record(job: tuple[int, str]) -> tuple[int, str, float, bool, float]:
-    """The test's recording with noise ``seed`` under probe ``probe``: its bounded ratio."""
-    seed, probe = job
-    sys.path.insert(0, str(ROOT / 'test' / 'identification'))
-    from test_loose_loops import _recording
+def diagnose_one(job: tuple[int, bool]) -> dict:
+    """Diagnose recording ``index`` (clean: noise only) with or without the loose baseline."""
+    from hyst_id.diagnosis import diagnose, DiagnoseSettings
+    index, loose = job
+    case = draw(index)
+    rec = Recording(case['t'], case['command'], case['measurement'], case['channel'])
+    t0 = time.monotonic()
+    d = diagnose(rec, settings=DiagnoseSettings(workers=1, loose_loops=loose))
+    return {'index': index, 'channel': case['channel'], 'true_proper': case['proper'],
+            'verdict': d.verdict, 'blocks': [f.mechanism for f in d.findings],
+            'final': d.final.er_holdout_percent / d.noise_floor_percent,
+            'kept_proper': d.to_dict()['proper_loop'], 'seconds': time.monotonic() - t0}
+
+
+def print_diagnoses(rows: list[dict]) -> None:
+    """The diagnosis table and its counts (every block claimed is a false claim)."""
+    print('  #  channel   true loop  verdict          blocks                    final x floor'
+          '  kept loop  seconds')
+    for r in rows:
+        print(f'#{r["index"]:3d} {r["channel"]:9s} '
+              f'{"proper" if r["true_proper"] else "improper":9s}  {r["verdict"]:15s}  '
+              f'{"+".join(r["blocks"]) or "-":24s}  {r["final"]:13.2f}  '
+              f'{"proper" if r["kept_proper"] else "improper":9s}  {r["seconds"]:7.0f}')
+    for truth in (True, False):
+        mine = [r for r in rows if r['true_proper'] == truth]
+        if mine:
+            finals = sorted(r['final'] for r in mine)
+            print(f'{"proper" if truth else "improper"} truths: {len(mine)}; false claims '
+                  f'{sum(bool(r["blocks"]) for r in mine)}; verdict none '
+                  f'{sum(r["verdict"] == "none" for r in mine)}; final within 1.2 x the floor '
+                  f'{sum(x <= 1.2 for x in finals)}, median {np.median(finals):.2f}, worst '
+                  f'{finals[-1]:.2f}; kept improper {sum(not r["kept_proper"] for r in mine)}')
+
+
+def test_record(job: tuple[int, str, bool]) -> tuple[int, str, float, bool, float, str]:
+    """The test's recording with noise ``seed`` under probe ``probe``: its bounded ratio.
+
+    Identify's RMS error over the true noise, or (``diagnose``) the diagnosis's
+    final held-out %e_r over its floor; whether the loop kept is proper; the
+    seconds; the diagnosis's verdict and blocks ('' for identify).
+    """
+    seed, probe, diagnose_it = job
+    from improper_chain import improper_recording as _recording
     os.environ['HYST_ID_ROUNDOFF_PROBE'] = probe
     rec, sigma = _recording(seed)
     t0 = time.monotonic()
+    if diagnose_it:
+        from hyst_id.diagnosis import diagnose, DiagnoseSettings
+        d = diagnose(rec, settings=DiagnoseSettings(workers=1))
+        return (seed, probe or '-', d.final.er_holdout_percent / d.noise_floor_percent,
+                d.to_dict()['proper_loop'], time.monotonic() - t0,
+                '+'.join([d.verdict] + [f.mechanism for f in d.findings]))
     ident = identify(rec, settings=IdentifySettings(workers=1))
     rms = ident.er_percent / 100.0 * float(np.sqrt(np.mean(rec.measurement ** 2)))
-    return seed, probe or '-', rms / sigma, ident.proper, time.monotonic() - t0
+    return seed, probe or '-', rms / sigma, ident.proper, time.monotonic() - t0, ''
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -153,23 +205,31 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument('--indices', type=int, nargs='*', help='these recordings instead')
     ap.add_argument('--workers', type=int, default=2)
     ap.add_argument('--without-loose', action='store_true')
+    ap.add_argument('--diagnose', action='store_true', help='diagnose instead of identify')
     ap.add_argument('--test-record', type=int, nargs='+', metavar='SEED',
                     help="the tests' recording with these noise seeds, under probes too")
     args = ap.parse_args(argv)
     if args.test_record:
         with ProcessPoolExecutor(args.workers) as pool:
-            got = list(pool.map(test_record, [(s, pr) for s in args.test_record
+            got = list(pool.map(test_record, [(s, pr, args.diagnose) for s in args.test_record
                                               for pr in ('', '1', '2')]))
-        print('seed  probe  rms / sigma  kept loop  seconds')
-        for seed, probe, ratio, proper, sec in got:
-            print(f'{seed:4d}  {probe:5s}  {ratio:11.3f}  {"proper" if proper else "improper":9s}'
-                  f'  {sec:7.0f}')
-        print(f'rms / sigma: {min(g[2] for g in got):.3f} - {max(g[2] for g in got):.3f} over '
-              f'{len(got)} runs; kept improper in {sum(not g[3] for g in got)}')
+        what = 'final / floor' if args.diagnose else 'rms / sigma'
+        print(f'seed  probe  {what:>13s}  kept loop  seconds  verdict')
+        for seed, probe, ratio, proper, sec, verdict in got:
+            print(f'{seed:4d}  {probe:5s}  {ratio:13.3f}  {"proper" if proper else "improper":9s}'
+                  f'  {sec:7.0f}  {verdict}')
+        print(f'{what}: {min(g[2] for g in got):.3f} - {max(g[2] for g in got):.3f} over '
+              f'{len(got)} runs; kept improper in {sum(not g[3] for g in got)}'
+              + (f'; verdict none in {sum(g[5] == "none" for g in got)}' if args.diagnose
+                 else ''))
         return 0
     indices = args.indices if args.indices else list(range(args.n))
     with ProcessPoolExecutor(args.workers) as pool:
-        rows = list(pool.map(one, [(i, not args.without_loose) for i in indices]))
+        rows = list(pool.map(diagnose_one if args.diagnose else one,
+                             [(i, not args.without_loose) for i in indices]))
+    if args.diagnose:
+        print_diagnoses(rows)
+        return 0
     print('  #  channel   excitation      true loop  kept loop  x true noise  x est. floor'
           '  seconds')
     for r in rows:

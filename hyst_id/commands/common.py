@@ -84,12 +84,13 @@ def add_settings_arguments(parser: argparse.ArgumentParser, identify: bool = Tru
                    help='fit (diagnose) the whole record even when it seems to start inside '
                    "the play; by default a poor fit is tried again from the command's first "
                    'reversal and the part before it is left out when that fits clearly better')
-    if not identify:
-        return
     g.add_argument('--proper-loops', action='store_true',
                    help='search proper loops only (those the compensator can invert); by '
-                   "default a fit left above the floor is tried again over the paper's wider "
-                   'set, loops whose output jumps at some reversals (docs/model.md)')
+                   "default a fit (a diagnosis's baseline) left above the floor is tried again "
+                   "over the paper's wider set, loops whose output jumps at some reversals "
+                   '(docs/model.md)')
+    if not identify:
+        return
     g.add_argument('--c', type=float, default=0.007, help='search-space contraction rate')
     g.add_argument('--xi', type=float, default=0.02, help='mutation subspace coefficient')
     g.add_argument('--er-bound', type=float, default=None,

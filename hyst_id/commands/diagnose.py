@@ -106,6 +106,7 @@ def _settings(args: argparse.Namespace):
         generations=args.generations, pop_size=args.pop_size, workers=args.workers,
         mechanisms=mechs, max_mechanisms=args.max_mechanisms, hops=args.hops,
         more_starts=args.more_starts, start_state=not args.whole_record,
+        loose_loops=not args.proper_loops,
         joint_generations=args.joint_generations)
 
 

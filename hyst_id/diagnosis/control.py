@@ -129,7 +129,7 @@ def without(current: FitResult, mid: str, data: Data, *, max_nfev: int) -> FitRe
     keep = [m for m in prev.mechanisms if m.id != mid]
     model = ComposedModel(prev.channel, keep, prev.ctx, prev.bounds[:prev.n_chain],
                           family=prev.spec.family.id, swapped_by=prev.swapped_by,
-                          hold=prev.hold, initial=prev.initial)
+                          hold=prev.hold, initial=prev.initial, proper=prev.spec.proper)
     p0 = model.pack(current.p[:prev.n_chain], {m.id: prev.theta(current.p, m.id) for m in keep})
     if not model.feasible(p0):
         return None

@@ -64,6 +64,7 @@ from hyst_id.diagnosis.empirical import empirical_block
 from hyst_id.diagnosis.exchange import drift_exchange, Exchange, exchanged_call, exchanges
 from hyst_id.diagnosis.exchange import gain_call
 from hyst_id.diagnosis.locate import Localization, locate, noise_std
+from hyst_id.diagnosis.loose_baseline import loose_baseline
 from hyst_id.diagnosis.mechanisms import get_mechanisms
 from hyst_id.diagnosis.mechanisms.base import Context, Mechanism
 from hyst_id.diagnosis.refit import contest
@@ -76,6 +77,7 @@ from hyst_id.diagnosis.trial import try_all
 from hyst_id.errors import ConfigError
 from hyst_id.identification.chains import chain_spec, ChainSpec
 from hyst_id.io.recording import Recording, roundoff_probe, validate_part, validate_recording
+from hyst_id.models.tk import loop_is_proper
 from hyst_id.signals.artefacts import find_artefacts
 from hyst_id.signals.noise import floor_percent
 from hyst_id.signals.reversals import command_context
@@ -222,6 +224,10 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
     say(f'baseline: identify (GAASS x {len(settings.seeds)} seeds, global phase) twice on the '
         f'first {n_train} samples')
     baseline, chain_starts = chain_fit(rec_train, spec, settings, data, ctx)
+    baseline, loose_note = loose_baseline(rec_train, spec, settings, data, ctx, baseline)
+    if loose_note:
+        say('baseline: only a loop whose corners are out of order fits; diagnosing over such')
+        spec = replace(spec, proper=False)
     spec, mechs, start_note = other_boundary(baseline.model.initial, spec, mechs)
     floor_h = floor_percent(y[n_train:], sigma)
     floor_t = floor_percent(y[:n_train], sigma)
@@ -308,7 +314,8 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
         findings[-1].blocked_cv = blocked.confirm(current, winner.fit)
         current = winner.fit
         loc = relocate(current)
-    notes = (list(rec.notes) + [start_note] * bool(start_note)
+    notes = ([loose_note] * bool(loose_note) + list(rec.notes)
+             + [start_note] * bool(start_note)
              + range_note(v_orig, n_train, data.judged_rows.size) + chain_notes)
     if len(findings) > 1:
         current, dropped = drop_superseded(current, [f.mechanism for f in findings], data,
@@ -386,6 +393,8 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
                                          'hold': current.model.hold
                                          if current.model.dynamic else '',
                                          'initial': current.model.initial,
+                                         'proper_loop': bool(loop_is_proper(*current.p[:8]))
+                                         if current.model.spec.family.id == 'tk' else True,
                                          'judged_holdout': _judged(data, baseline, current)})
 
 

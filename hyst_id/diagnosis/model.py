@@ -36,6 +36,7 @@ lets the data choose (:func:`held`).
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Sequence
 
 import numpy as np
@@ -102,11 +103,16 @@ class ComposedModel:
         The boundary of their loops H and B start on (``ChainSpec.initial``); blocks
         that simulate the actuator themselves (:attr:`Mechanism.stage` ``'actuator'``)
         start it rising and are not used with a falling start.
+    proper : bool, optional
+        Whether H's loops must be proper (``ChainSpec.proper``, the default) or may
+        be any the paper's constraints admit (a baseline that only such a loop
+        fits: :func:`hyst_id.diagnosis.challenge.loose_baseline`).
     """
 
     def __init__(self, channel: str, mechanisms: Sequence[Mechanism], ctx: Context,
                  chain_bounds: np.ndarray, family: str | None = None,
-                 swapped_by: str = '', hold: str = 'before', initial: str = 'rising') -> None:
+                 swapped_by: str = '', hold: str = 'before', initial: str = 'rising',
+                 proper: bool = True) -> None:
         if hold not in HOLDS:
             raise ConfigError(f'hold must be one of {HOLDS}, got {hold!r}')
         if initial not in INITIAL_STATES:
@@ -120,8 +126,9 @@ class ComposedModel:
         self.swapped_by = swapped_by
         self.ctx = ctx
         self.mechanisms = tuple(sorted(mechanisms, key=lambda m: STAGES.index(m.stage)))
-        self.spec = chain_spec(channel, family=family, initial=initial)
-        self.position_spec = chain_spec('position', family=family, initial=initial)
+        self.spec = replace(chain_spec(channel, family=family, initial=initial), proper=proper)
+        self.position_spec = replace(chain_spec('position', family=family, initial=initial),
+                                     proper=proper)
         self.n_chain = self.spec.n_params
         bounds = [np.asarray(chain_bounds, dtype=float)]
         self.slices: dict[str, slice] = {}

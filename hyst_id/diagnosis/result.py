@@ -91,6 +91,12 @@ class DiagnoseSettings:
         the local fits had missed (#162, #164, #175) at seconds per search, two
         per round: on by default it slowed the test suite's diagnoses by about
         two fifths, beyond its 30 minutes (docs/diagnosis.md).
+    loose_loops : bool
+        When the proper baseline stays above its floor, search the loops the
+        paper's constraints admit and the proper set does not (corners out of
+        order), and run the diagnosis over them when such a loop alone fits the
+        training part (:mod:`hyst_id.diagnosis.loose_baseline`). On by default;
+        off where the set feeds H⁻¹ (the paper's experiment).
     should_stop : callable, optional
         Passed to the baseline's identifications (``identify(should_stop=...)``:
         looked at before each jump of hopping and each generation of an
@@ -112,6 +118,7 @@ class DiagnoseSettings:
     more_starts: bool = False
     start_state: bool = True
     joint_generations: int = 0
+    loose_loops: bool = True
     should_stop: Callable[[], bool] | None = field(default=None, compare=False, repr=False)
 
 

@@ -223,7 +223,7 @@ def try_mechanism(m: Mechanism, current: FitResult, data: Data, ctx: Context,
             model = ComposedModel(ctx.channel, list(prev.mechanisms) + [m], ctx,
                                   prev.bounds[:prev.n_chain], family=prev.spec.family.id,
                                   swapped_by=prev.swapped_by, hold=hold,
-                                  initial=prev.initial)
+                                  initial=prev.initial, proper=prev.spec.proper)
             p_prev = model.pack(current.p[:prev.n_chain], thetas)
             # the data-built starts are the baseline family's chains
             got = fit_model(model, data, p_prev, m, budget=settings.fit_budget,
@@ -247,7 +247,8 @@ def _as_twin(m: Mechanism, fit: FitResult, current: FitResult, data: Data, ctx: 
     model = ComposedModel(ctx.channel, [m if pm.id == m.fits_as else pm
                                         for pm in prev.mechanisms], ctx,
                           prev.bounds[:prev.n_chain], family=prev.spec.family.id,
-                          swapped_by=prev.swapped_by, hold=prev.hold, initial=prev.initial)
+                          swapped_by=prev.swapped_by, hold=prev.hold, initial=prev.initial,
+                          proper=prev.spec.proper)
     return judge(m, current, evaluate(model, data, fit.p, fit.nfev), data, ctx, settings, loc)
 
 

@@ -318,7 +318,9 @@ def _adaptive(sc: ScenarioResult, rig: RigParams, config: ExperimentConfig,
     from hyst_id.diagnosis import DiagnoseSettings
     from hyst_id.experiment.columns import adaptive_columns, diagnose_channel
 
-    settings = diagnose_settings or DiagnoseSettings(max_mechanisms=3)
+    # the diagnosis's set feeds H^-1: proper loops only, as the identification's
+    settings = replace(diagnose_settings or DiagnoseSettings(max_mechanisms=3),
+                       loose_loops=False)
     lo, hi = config.command_limits_ma
     run = sc.ident_run
     for ch in channels:

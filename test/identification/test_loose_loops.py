@@ -27,6 +27,7 @@ from __future__ import annotations
 from dataclasses import replace
 import json
 
+from improper_chain import H, IMPROPER, improper_recording, X
 import numpy as np
 import pytest
 from reference_sim import simulate as reference_simulate
@@ -38,18 +39,8 @@ from hyst_id.identification import identify, IdentifySettings
 from hyst_id.identification.chains import chain_spec
 from hyst_id.identification.loose_phase import LOOSE_GAIN, loose_retry, LOOSE_WITHIN
 from hyst_id.identification.result import Identification
-from hyst_id.io.recording import Recording
 from hyst_id.models.registry import get_family
 from hyst_id.models.tk import check_hysteresis, loop_corners, loop_is_proper
-
-#: A chain drawn as ``bench/improper_loops.py`` draws (its recording 9): the left line meets
-#: the bottom line right of where the right line does (A > B) and the top line right of it
-#: (D > C).
-IMPROPER = {'m_l': 1.063, 'm_r': 1.296, 'm_t': 0.553, 'm_b': 0.362, 'c_l': 0.964,
-            'c_r': 1.841, 'c_t': 4.826, 'c_b': 4.485, 'm_bl': 1.388, 'c_bl': -0.158,
-            'c_br': 0.158}
-H = [IMPROPER[k] for k in ('m_l', 'm_r', 'm_t', 'm_b', 'c_l', 'c_r', 'c_t', 'c_b')]
-X = np.array(H + [IMPROPER['m_bl'], IMPROPER['c_bl'], IMPROPER['c_br']])
 
 
 def test_the_paper_set_admits_a_loop_the_proper_set_refuses():
@@ -159,19 +150,9 @@ def test_the_lines_an_improper_loop_never_reaches_are_still_said():
 RATIO_BOUND = 1.3
 
 
-def _recording(seed: int) -> tuple[Recording, float]:
-    """The improper chain under a decaying sine, 1,500 samples, noise 1 % of the span."""
-    t = np.arange(1500) * 0.05
-    v = 9.0 + 2.0 * np.exp(-t / 60.0) * np.sin(2 * np.pi * t / 7.0)
-    x = reference_simulate('position', IMPROPER, t, v)
-    sigma = 0.01 * float(np.ptp(x))
-    y = x + np.random.default_rng(seed).normal(0.0, sigma, x.size)
-    return Recording(t, v, y, 'position'), sigma
-
-
 @pytest.mark.slow
 def test_identify_reaches_the_floor_on_an_improper_loop():
-    rec, sigma = _recording(0)
+    rec, sigma = improper_recording(0)
     ident = identify(rec, settings=IdentifySettings(workers=1))
     rms = ident.er_percent / 100 * float(np.sqrt(np.mean(rec.measurement ** 2)))
     assert not ident.proper
@@ -181,7 +162,7 @@ def test_identify_reaches_the_floor_on_an_improper_loop():
 
 @pytest.mark.slow
 def test_the_cli_reports_an_improper_loop_and_writes_no_compensator_file(tmp_path, capsys):
-    rec, sigma = _recording(1)
+    rec, sigma = improper_recording(1)
     csv = tmp_path / 'run.csv'
     np.savetxt(csv, np.c_[rec.t_s, rec.command, rec.measurement], delimiter=',',
                header='t,command,measurement', comments='')
