@@ -35,6 +35,7 @@ PKG = ROOT / 'hyst_id'
 #: Stage -> rank. A module may import stages of a lower rank and its own stage.
 RANKS = {
     'errors': 0, 'pins': 0, '_deprecated': 0,
+    'checks': 1,
     'signals': 1,
     'io': 2,
     'models': 3, 'solvers': 3,

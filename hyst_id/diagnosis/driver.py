@@ -76,6 +76,7 @@ from hyst_id.diagnosis.ties import alternatives_record, choose, close_calls, hol
 from hyst_id.diagnosis.trial import try_all
 from hyst_id.errors import ConfigError
 from hyst_id.identification.chains import chain_spec, ChainSpec
+from hyst_id.identification.quality import response_warnings
 from hyst_id.io.recording import Recording, roundoff_probe, validate_part, validate_recording
 from hyst_id.models.tk import loop_is_proper
 from hyst_id.signals.artefacts import find_artefacts
@@ -363,12 +364,15 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
     if withdrawn:
         extra['withdrawn'] = withdrawn
     held = [f for f in findings if confirmed(f.blocked_cv)]
+    no_response = response_warnings(baseline.er_train_percent, y[:n_train])
     if held:
         verdict = held[0].mechanism
     elif findings:
         verdict = 'unknown'     # the split accepted blocks that the time blocks do not hold up
-    elif rounds and current.er_holdout_percent > UNKNOWN_FACTOR * floor_h:
-        verdict = 'unknown'     # something is missing, and it is none of the library
+    elif no_response:           # noise, a wrong column: 'none' would read as a clean actuator
+        verdict, extra['no_response'] = 'unknown', no_response[0]
+    elif current.er_holdout_percent > UNKNOWN_FACTOR * floor_h:
+        verdict = 'unknown'     # something is missing: none of the library (or none tried)
         say('the chain on the whole record: is anything missing at all?')
         whole = whole_record_er(Recording(t, v, y, rec.channel, source=rec.source), spec,
                                 settings)

@@ -65,7 +65,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from hyst_id.errors import RecordingError
-from hyst_id.signals.noise import REPEAT_TOLERANCE, robust_noise_std
+from hyst_id.signals.noise import repeat_tolerance, robust_noise_std
 from hyst_id.signals.reversals import reversal_indices
 
 __all__ = ['MeasuredLoop', 'measured_loop', 'MIN_SAMPLES', 'N_LEVELS', 'RATE_GROWTH',
@@ -233,7 +233,7 @@ def _sweeps(v: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.nd
 def _level_edges(v: np.ndarray) -> np.ndarray:
     """Edges of :data:`N_LEVELS` bins of equal counts of distinct command values.
 
-    Values within round-off (:data:`~hyst_id.signals.noise.REPEAT_TOLERANCE`)
+    Values within round-off (:func:`~hyst_id.signals.noise.repeat_tolerance`)
     count as one (a held step stays one value when its last bits move), and
     each inner edge lies midway between two distinct values, so no sample
     sits on an edge where a last-bit change would move it to the next bin.
@@ -241,7 +241,7 @@ def _level_edges(v: np.ndarray) -> np.ndarray:
     x = np.sort(v)
     if x.size == 0:
         return x
-    keep = np.r_[True, np.diff(x) > REPEAT_TOLERANCE * float(np.max(np.abs(x)))]
+    keep = np.r_[True, np.diff(x) > repeat_tolerance(x)]
     d = x[keep]
     if d.size < 2:
         return d

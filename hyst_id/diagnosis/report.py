@@ -269,7 +269,16 @@ def format_diagnosis(d: Any) -> str:
     lines += [f'  - {s}' for s in d.localization.summary(unit)]
     lines.append('')
     if not d.findings:
-        if not d.rounds:
+        if d.extra.get('no_response'):
+            lines.append('verdict: unknown - the measurement does not follow the command (the '
+                         'warning above): nothing about the actuator can be diagnosed from it; '
+                         'check the sensor, the column and that the actuator moved.')
+        elif not d.rounds and d.verdict == 'unknown':
+            ratio = over(d.final.er_holdout_percent, d.noise_floor_percent)
+            lines.append(f'verdict: unknown - the model misses something ({ratio:.2f} x the '
+                         'noise floor on held-out data) and no block of the library was tried '
+                         '(max_mechanisms 0).')
+        elif not d.rounds:
             lines.append('verdict: none - the baseline residual is white, independent of the '
                          'command and at the noise floor on held-out data: this record shows no '
                          'physics that the model leaves out.')

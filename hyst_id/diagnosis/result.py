@@ -26,10 +26,12 @@ from typing import Any, Callable
 
 import numpy as np
 
+from hyst_id.checks import check_fields
 from hyst_id.diagnosis.blocked_cv import confirmed
 from hyst_id.diagnosis.locate import Localization
 from hyst_id.diagnosis.measured_loop import measured_loop, MeasuredLoop
 from hyst_id.diagnosis.select import Criteria, FitResult
+from hyst_id.errors import ConfigError
 from hyst_id.io.jsonable import jsonable
 
 __all__ = ['DiagnoseSettings', 'Diagnosis', 'Finding']
@@ -120,6 +122,15 @@ class DiagnoseSettings:
     joint_generations: int = 0
     loose_loops: bool = True
     should_stop: Callable[[], bool] | None = field(default=None, compare=False, repr=False)
+
+    def __post_init__(self) -> None:
+        check_fields(self, seeds='seeds', positive=('train_fraction',),
+                     at_least={'generations': 1, 'pop_size': 2, 'workers': 0,
+                               'max_mechanisms': 0, 'fit_budget': 1, 'hops': 0,
+                               'joint_generations': 0})
+        if not self.train_fraction < 1.0:
+            raise ConfigError(f'DiagnoseSettings.train_fraction must be in (0, 1), got '
+                              f'{self.train_fraction!r}')
 
 
 @dataclass

@@ -38,6 +38,12 @@ MIN_HELDOUT_SAMPLES = 40
 def require_split(n_train: int, n_total: int) -> None:
     """A :class:`RecordingError` when the split leaves too few samples to judge a block by."""
     if n_train < MIN_TRAIN_SAMPLES or n_total - n_train < MIN_HELDOUT_SAMPLES:
+        if n_total >= MIN_TRAIN_SAMPLES + MIN_HELDOUT_SAMPLES:     # the split, not the record
+            raise RecordingError(
+                f'the training fraction leaves {n_train} training and {n_total - n_train} '
+                f'held-out samples of {n_total} (need at least {MIN_TRAIN_SAMPLES} and '
+                f'{MIN_HELDOUT_SAMPLES} to judge a block): choose a train_fraction '
+                '(--train-fraction) nearer 0.7')
         raise RecordingError(
             f'record too short to diagnose: {n_train} training and {n_total - n_train} '
             f'held-out samples (need at least {MIN_TRAIN_SAMPLES} and '

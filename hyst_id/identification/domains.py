@@ -184,9 +184,11 @@ def loop_box(rec: Recording, settings: DomainSettings | None = None,
     v_lo, v_hi = float(np.min(v)), float(np.max(v))
     span_v = v_hi - v_lo
     y_lo, y_hi = (float(q) for q in np.percentile(y, [0.5, 99.5]))
-    if not span_v > 0.0 or not y_hi > y_lo:
-        raise ConfigError('cannot derive search domains: the command or the measurement '
-                          'does not move')
+    if not span_v > 0.0:
+        raise ConfigError('cannot derive search domains: the command does not move')
+    if not y_hi > y_lo:
+        raise ConfigError('cannot derive search domains: 99 % of the measurement samples '
+                          f'hold one value ({y_lo:.6g}); the rest are outliers, not a response')
     if calibration is None:
         u_mid, span_u = 0.0, span_v                      # virtual scale
     else:

@@ -26,6 +26,7 @@ from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
 
+from hyst_id.checks import check_fields
 from hyst_id.identification.chains import chain_spec, ChainSpec
 from hyst_id.models.tk import loop_is_proper
 
@@ -164,6 +165,14 @@ class IdentifySettings:
     more_starts: bool = False
     start_state: bool = True
     loose_loops: bool = True
+
+    def __post_init__(self) -> None:
+        check_fields(self, seeds='seeds', choices={'conventions': ('auto', 'given')},
+                     at_least={'workers': 0, 'refine_max_nfev': 1, 'refine_top': 1,
+                               'restarts': 0, 'restart_patience': 0, 'global_evals': 0,
+                               'global_runs': 0, 'hops': 0, 'search_samples': 0},
+                     positive=('restart_factor', 'er_bound_percent', 'global_factor',
+                               'long_runs_within'))
 
 
 @dataclass

@@ -42,12 +42,14 @@ from math import comb
 import numpy as np
 
 __all__ = ['estimate_noise_std', 'floor_percent', 'held_share', 'noise_floor_percent',
-           'OFFSET_SPANS', 'offset_words', 'quantum', 'REPEAT_TOLERANCE', 'repeat_tolerance',
-           'robust_noise_std', 'STUCK_SHARE']
+           'OFFSET_SPANS', 'offset_words', 'quantum', 'REPEAT_FLOOR', 'REPEAT_TOLERANCE',
+           'repeat_tolerance', 'robust_noise_std', 'STUCK_SHARE']
 
-#: Steps below this share of the signal's magnitude count as repeats: a value written
+#: Steps below this share of the signal's spread count as repeats: a value written
 #: through a unit conversion, or perturbed at round-off level, is still the same A/D count.
 REPEAT_TOLERANCE = 1e-9
+#: ...and never below this share of the largest value (:func:`repeat_tolerance`).
+REPEAT_FLOOR = 1e-11
 
 #: Share of the differences kept by the trimmed RMS.
 _KEEP = 0.95
@@ -91,8 +93,19 @@ def estimate_noise_std(measurement: np.ndarray) -> float:
 
 
 def repeat_tolerance(y: np.ndarray) -> float:
-    """Steps of ``y`` at most this large are repeats: its round-off (:data:`REPEAT_TOLERANCE`)."""
-    return REPEAT_TOLERANCE * float(np.max(np.abs(y))) if y.size else 0.0
+    """Steps of ``y`` at most this large are repeats: its round-off (:data:`REPEAT_TOLERANCE`).
+
+    Relative to the values' spread, not their size: a measurement riding on a large
+    offset (1e8 with steps of 0.01) had half its samples called frozen when the
+    tolerance was a share of ``max |y|``. Never below :data:`REPEAT_FLOOR` of the
+    largest value (ten times the round-off probe's default perturbation,
+    :func:`hyst_id.io.recording.roundoff_probe`), so a last-bit change still does not
+    move the answer.
+    """
+    y = np.asarray(y, dtype=np.float64)
+    if not y.size:
+        return 0.0
+    return max(REPEAT_TOLERANCE * float(np.ptp(y)), REPEAT_FLOOR * float(np.max(np.abs(y))))
 
 
 #: Share of repeated samples above which :func:`robust_noise_std` leaves the repeats out

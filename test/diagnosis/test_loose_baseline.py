@@ -69,26 +69,29 @@ class _Searched(Exception):
     pass
 
 
-def _stand_in(er_train_percent: float) -> SimpleNamespace:
+def _stand_in(er_train_percent: float, er_holdout_percent: float) -> SimpleNamespace:
     """A proper baseline as :func:`loose_baseline` reads it."""
     spec = SimpleNamespace(proper=True, family=SimpleNamespace(id='tk'))
     return SimpleNamespace(model=SimpleNamespace(spec=spec, mechanisms=(), initial='rising',
                                                  hold='before'),
-                           er_train_percent=er_train_percent)
+                           er_train_percent=er_train_percent,
+                           er_holdout_percent=er_holdout_percent)
 
 
-@pytest.mark.parametrize('ratio, loose_loops, searched', [
-    (5.0, True, True), (5.0, False, False), (0.9 * LOOSE_FROM, True, False)])
+@pytest.mark.parametrize('train, held_out, loose_loops, searched', [
+    (5.0, 1.0, True, True), (1.0, 5.0, True, True), (5.0, 5.0, False, False),
+    (0.9 * LOOSE_FROM, 0.9 * LOOSE_FROM, True, False)])
 def test_the_loose_search_runs_only_when_asked_and_above_the_floor(
-        monkeypatch, ratio, loose_loops, searched):
+        monkeypatch, train, held_out, loose_loops, searched):
     """Off (``loose_loops``, ``--proper-loops``) or with a baseline near its floor: not run."""
     def search(*args, **kwargs):
         raise _Searched
     monkeypatch.setattr(loose_module, 'identify', search)
     rec, sigma = improper_recording(0)
     n = 1000
-    data = Data(t_s=rec.t_s, v=rec.command, y=rec.measurement, n_train=n, noise_std=sigma)
-    best = _stand_in(ratio * floor_percent(rec.measurement[:n], sigma))
+    y = rec.measurement
+    data = Data(t_s=rec.t_s, v=rec.command, y=y, n_train=n, noise_std=sigma)
+    best = _stand_in(train * floor_percent(y[:n], sigma), held_out * floor_percent(y[n:], sigma))
     settings = DiagnoseSettings(workers=1, loose_loops=loose_loops)
     spec = chain_spec('position')
     if searched:
