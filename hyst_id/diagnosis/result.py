@@ -129,8 +129,8 @@ class DiagnoseSettings:
                                'max_mechanisms': 0, 'fit_budget': 1, 'hops': 0,
                                'joint_generations': 0})
         if not self.train_fraction < 1.0:
-            raise ConfigError(f'DiagnoseSettings.train_fraction must be in (0, 1), got '
-                              f'{self.train_fraction!r}')
+            raise ConfigError('DiagnoseSettings.train_fraction: the train fraction must be in '
+                              f'(0, 1), got {self.train_fraction!r}')
 
 
 @dataclass
