@@ -22,11 +22,14 @@ claims on it is a false claim. Its proper baseline stops near 5 x the floor
 
 from __future__ import annotations
 
+import json
 from types import SimpleNamespace
 
 from improper_chain import improper_recording
+import numpy as np
 import pytest
 
+from hyst_id.cli import main
 from hyst_id.diagnosis import diagnose, DiagnoseSettings
 from hyst_id.diagnosis import loose_baseline as loose_module
 from hyst_id.diagnosis.export import compensator_set
@@ -63,6 +66,21 @@ def test_a_clean_improper_loop_is_diagnosed_none_over_such_loops(diagnosis):
 def test_the_compensator_set_of_an_improper_loop_is_refused(diagnosis):
     with pytest.raises(InvalidParametersError):
         compensator_set(diagnosis)
+
+
+def test_the_cli_refuses_a_compensator_file_for_it_and_says_why(tmp_path, capsys):
+    rec, _ = improper_recording(1)
+    csv = tmp_path / 'run.csv'
+    np.savetxt(csv, np.c_[rec.t_s, rec.command, rec.measurement], delimiter=',',
+               header='t,command,measurement', comments='')
+    out, params = tmp_path / 'd.json', tmp_path / 'set.yaml'
+    assert main(['diagnose', str(csv), '--quiet', '--workers', '1', '--json', str(out),
+                 '--params-out', str(params)]) == 2
+    err = capsys.readouterr().err
+    assert 'not a proper one' in err and '--proper-loops --params-out' in err
+    assert not params.exists()
+    doc = json.loads(out.read_text())           # the report is written before the refusal
+    assert doc['verdict'] == 'none' and doc['proper_loop'] is False
 
 
 class _Searched(Exception):
