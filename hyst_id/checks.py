@@ -12,7 +12,7 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
-"""Checks of settings objects at construction, so the API refuses what the CLI refuses.
+"""Range checks of settings objects at construction, so the API refuses what it cannot run.
 
 An independent fuzz review found ``IdentifySettings(seeds=(-1,))`` failing inside
 numpy with a bare ``ValueError``, and negative workers, restarts or hops, an

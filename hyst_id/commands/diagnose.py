@@ -119,7 +119,7 @@ def _write_params(diag, path: str) -> None:
         raise ConfigError('--params-out needs the model diagnosis (not --sim)')
     if diag.extra.get('proper_loop') is False:
         raise ConfigError(f'cannot write {path}: the loop the diagnosis ran over is not a proper '
-                          'one (its output jumps at some reversals, first note of the report) '
+                          'one (its output jumps at some reversals: see the notes) '
                           'and the compensator cannot invert it; `hyst-id identify '
                           '--proper-loops --params-out` writes the best proper loop')
     try:

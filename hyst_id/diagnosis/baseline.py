@@ -128,6 +128,7 @@ def _quick_key(rec_train: Recording, spec: ChainSpec, settings) -> str:
         h.update(np.ascontiguousarray(a, dtype=float).tobytes())
     search = {k: v for k, v in identify_base(settings).items() if k != 'workers'}
     h.update(repr((rec_train.channel, spec.channel, spec.family.id, spec.initial, spec.hold,
+                   spec.proper,
                    spec.calibration, spec.domain_source, sorted(search.items()),
                    os.environ.get(ROUNDOFF_PROBE_ENV, '').strip())).encode())
     return h.hexdigest()

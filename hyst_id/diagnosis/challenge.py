@@ -107,9 +107,11 @@ def chain_fit(rec_train: Recording, spec: ChainSpec, settings: DiagnoseSettings,
     holds = HOLDS if rec_train.channel != 'position' else HOLDS[:1]
     other = 'falling' if spec.initial == 'rising' else 'rising'
     pairs = [(model, x0) for model in [ComposedModel(rec_train.channel, [], ctx, spec.bounds,
-                                                     hold=h, initial=spec.initial) for h in holds]
+                                                     hold=h, initial=spec.initial,
+                                                     proper=spec.proper) for h in holds]
              for x0 in x_fits + starts] + [
-        (ComposedModel(rec_train.channel, [], ctx, spec.bounds, hold=h, initial=other), x0)
+        (ComposedModel(rec_train.channel, [], ctx, spec.bounds, hold=h, initial=other,
+                       proper=spec.proper), x0)
         for h in holds for x0 in others]
     polished = sorted((got + (x0, model) for got, (model, x0) in zip(
         polish_all(pairs, data, 2 * settings.fit_budget, settings.workers), pairs)),
@@ -119,7 +121,7 @@ def chain_fit(rec_train: Recording, spec: ChainSpec, settings: DiagnoseSettings,
     if best.model.initial != spec.initial:
         mine = evaluate(own[0][4], data, own[0][0], own[0][2])
         as_other = ComposedModel(rec_train.channel, [], ctx, spec.bounds, hold=own[0][4].hold,
-                                 initial=other)
+                                 initial=other, proper=spec.proper)
         if not _starts_other(mine, best, evaluate(as_other, data, own[0][0]), data,
                              settings.criteria.bic_drop):
             best, polished = mine, own  # the other boundary only where the start says so

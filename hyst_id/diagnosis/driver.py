@@ -64,7 +64,7 @@ from hyst_id.diagnosis.empirical import empirical_block
 from hyst_id.diagnosis.exchange import drift_exchange, Exchange, exchanged_call, exchanges
 from hyst_id.diagnosis.exchange import gain_call
 from hyst_id.diagnosis.locate import Localization, locate, noise_std
-from hyst_id.diagnosis.loose_baseline import loose_baseline
+from hyst_id.diagnosis.loose_baseline import kept_loose_note, loose_baseline
 from hyst_id.diagnosis.mechanisms import get_mechanisms
 from hyst_id.diagnosis.mechanisms.base import Context, Mechanism
 from hyst_id.diagnosis.refit import contest
@@ -78,7 +78,6 @@ from hyst_id.errors import ConfigError
 from hyst_id.identification.chains import chain_spec, ChainSpec
 from hyst_id.identification.quality import response_warnings
 from hyst_id.io.recording import Recording, roundoff_probe, validate_part, validate_recording
-from hyst_id.models.tk import loop_is_proper
 from hyst_id.signals.artefacts import find_artefacts
 from hyst_id.signals.noise import floor_percent
 from hyst_id.signals.reversals import command_context
@@ -315,7 +314,7 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
         findings[-1].blocked_cv = blocked.confirm(current, winner.fit)
         current = winner.fit
         loc = relocate(current)
-    notes = ([loose_note] * bool(loose_note) + list(rec.notes)
+    notes = (list(rec.notes)
              + [start_note] * bool(start_note)
              + range_note(v_orig, n_train, data.judged_rows.size) + chain_notes)
     if len(findings) > 1:
@@ -371,8 +370,10 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
         verdict = 'unknown'     # the split accepted blocks that the time blocks do not hold up
     elif no_response:           # noise, a wrong column: 'none' would read as a clean actuator
         verdict, extra['no_response'] = 'unknown', no_response[0]
+    elif not rounds and current.er_holdout_percent > UNKNOWN_FACTOR * floor_h:
+        verdict = 'unknown'     # something is missing, and no block was tried (max_mechanisms 0)
     elif current.er_holdout_percent > UNKNOWN_FACTOR * floor_h:
-        verdict = 'unknown'     # something is missing: none of the library (or none tried)
+        verdict = 'unknown'     # something is missing, and it is none of the library
         say('the chain on the whole record: is anything missing at all?')
         whole = whole_record_er(Recording(t, v, y, rec.channel, source=rec.source), spec,
                                 settings)
@@ -382,6 +383,8 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
             verdict = 'none'    # the chain makes every sample: the split did not decide
     else:
         verdict = 'none'
+    proper_loop, kept = kept_loose_note(current, loose_note)
+    notes = [kept] * bool(kept) + notes
     return Diagnosis(channel=rec.channel, source=rec.source, mode='model',
                      verdict=verdict, empirical=empirical, t_s=t,
                      command=v_orig, measurement=y, n_train=n_train, baseline=baseline,
@@ -397,8 +400,7 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
                                          'hold': current.model.hold
                                          if current.model.dynamic else '',
                                          'initial': current.model.initial,
-                                         'proper_loop': bool(loop_is_proper(*current.p[:8]))
-                                         if current.model.spec.family.id == 'tk' else True,
+                                         'proper_loop': proper_loop,
                                          'judged_holdout': _judged(data, baseline, current)})
 
 

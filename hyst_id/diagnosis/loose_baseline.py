@@ -56,7 +56,7 @@ from hyst_id.io.recording import Recording
 from hyst_id.models.tk import loop_corners, loop_is_proper
 from hyst_id.signals.noise import floor_percent
 
-__all__ = ['LOOSE_EVEN', 'LOOSE_FROM', 'LOOSE_NEAR', 'loose_baseline']
+__all__ = ['kept_loose_note', 'LOOSE_EVEN', 'LOOSE_FROM', 'LOOSE_NEAR', 'loose_baseline']
 
 #: The loose search runs when the proper baseline's training or held-out %e_r is above this
 #: multiple of that part's floor (below it a diagnosis claims no block either: a round
@@ -131,6 +131,17 @@ def loose_baseline(rec_train: Recording, spec: ChainSpec, settings: DiagnoseSett
         return best, ''     # a proper loop the baseline had missed: left to its own search
     return fit, _note(fit.p[:8], ctx, best.er_train_percent / floor,
                       fit.er_train_percent / floor)
+
+
+def kept_loose_note(final: FitResult, note: str) -> tuple[bool, str]:
+    """Whether the diagnosis's final loop is proper, and ``note`` only when it is not.
+
+    A loose baseline's blocks may bring the chain back to a proper loop; the
+    note that the loop is not proper then no longer holds.
+    """
+    proper = (bool(loop_is_proper(*final.p[:8])) if final.model.spec.family.id == 'tk'
+              else True)
+    return proper, '' if proper else note
 
 
 def _note(h: np.ndarray, ctx: Context, proper_ratio: float, loose_ratio: float) -> str:

@@ -106,7 +106,7 @@ class ComposedModel:
     proper : bool, optional
         Whether H's loops must be proper (``ChainSpec.proper``, the default) or may
         be any the paper's constraints admit (a baseline that only such a loop
-        fits: :func:`hyst_id.diagnosis.challenge.loose_baseline`).
+        fits: :func:`hyst_id.diagnosis.loose_baseline.loose_baseline`).
     """
 
     def __init__(self, channel: str, mechanisms: Sequence[Mechanism], ctx: Context,

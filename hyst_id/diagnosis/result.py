@@ -22,6 +22,7 @@ with its JSON document, its ``/diagnostics`` status and its text report).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from numbers import Real
 from typing import Any, Callable
 
 import numpy as np
@@ -124,11 +125,12 @@ class DiagnoseSettings:
     should_stop: Callable[[], bool] | None = field(default=None, compare=False, repr=False)
 
     def __post_init__(self) -> None:
-        check_fields(self, seeds='seeds', positive=('train_fraction',),
+        check_fields(self, seeds='seeds',
                      at_least={'generations': 1, 'pop_size': 2, 'workers': 0,
                                'max_mechanisms': 0, 'fit_budget': 1, 'hops': 0,
                                'joint_generations': 0})
-        if not self.train_fraction < 1.0:
+        if (isinstance(self.train_fraction, bool) or not isinstance(self.train_fraction, Real)
+                or not 0.0 < self.train_fraction < 1.0):
             raise ConfigError('DiagnoseSettings.train_fraction: the train fraction must be in '
                               f'(0, 1), got {self.train_fraction!r}')
 
@@ -275,6 +277,10 @@ class Diagnosis:
                 values[f'{f.mechanism}.{name}'] = f'{q.value:.4g} {q.unit}'.strip()
             if f.compensation:
                 values[f'{f.mechanism}.compensation'] = f.compensation['kind']
+        if self.verdict == 'unknown' and self.extra.get('no_response'):
+            return 'warn', 'the measurement does not follow the command', values
+        if self.verdict == 'unknown' and not self.rounds:
+            return 'warn', 'the model misses something; no block of the library was tried', values
         if self.verdict == 'unknown':
             return 'warn', ('something is missing that no mechanism of the library explains'
                             + (f': {self.empirical.summary()}' if self.empirical else '')), values
