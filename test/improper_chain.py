@@ -28,7 +28,7 @@ from reference_sim import simulate as reference_simulate
 
 from hyst_id.io.recording import Recording
 
-__all__ = ['H', 'IMPROPER', 'improper_recording', 'X']
+__all__ = ['H', 'IMPROPER', 'improper_csv', 'improper_recording', 'X']
 
 #: A chain drawn as ``bench/improper_loops.py`` draws (its recording 9): the left line meets
 #: the bottom line right of where the right line does (A > B) and the top line right of it
@@ -48,3 +48,11 @@ def improper_recording(seed: int) -> tuple[Recording, float]:
     sigma = 0.01 * float(np.ptp(x))
     y = x + np.random.default_rng(seed).normal(0.0, sigma, x.size)
     return Recording(t, v, y, 'position'), sigma
+
+
+def improper_csv(seed: int, path) -> tuple[Recording, float]:
+    """:func:`improper_recording`, also written to ``path`` as a CSV the CLI reads."""
+    rec, sigma = improper_recording(seed)
+    np.savetxt(path, np.c_[rec.t_s, rec.command, rec.measurement], delimiter=',',
+               header='t,command,measurement', comments='')
+    return rec, sigma

@@ -25,8 +25,7 @@ from __future__ import annotations
 import json
 from types import SimpleNamespace
 
-from improper_chain import improper_recording
-import numpy as np
+from improper_chain import improper_csv, improper_recording
 import pytest
 
 from hyst_id.cli import main
@@ -69,10 +68,8 @@ def test_the_compensator_set_of_an_improper_loop_is_refused(diagnosis):
 
 
 def test_the_cli_refuses_a_compensator_file_for_it_and_says_why(tmp_path, capsys):
-    rec, _ = improper_recording(1)
     csv = tmp_path / 'run.csv'
-    np.savetxt(csv, np.c_[rec.t_s, rec.command, rec.measurement], delimiter=',',
-               header='t,command,measurement', comments='')
+    improper_csv(1, csv)
     out, params = tmp_path / 'd.json', tmp_path / 'set.yaml'
     assert main(['diagnose', str(csv), '--quiet', '--workers', '1', '--json', str(out),
                  '--params-out', str(params)]) == 2

@@ -27,7 +27,7 @@ from __future__ import annotations
 from dataclasses import replace
 import json
 
-from improper_chain import H, IMPROPER, improper_recording, X
+from improper_chain import H, IMPROPER, improper_csv, improper_recording, X
 import numpy as np
 import pytest
 from reference_sim import simulate as reference_simulate
@@ -162,10 +162,8 @@ def test_identify_reaches_the_floor_on_an_improper_loop():
 
 @pytest.mark.slow
 def test_the_cli_reports_an_improper_loop_and_writes_no_compensator_file(tmp_path, capsys):
-    rec, sigma = improper_recording(1)
     csv = tmp_path / 'run.csv'
-    np.savetxt(csv, np.c_[rec.t_s, rec.command, rec.measurement], delimiter=',',
-               header='t,command,measurement', comments='')
+    rec, sigma = improper_csv(1, csv)
     params, result = tmp_path / 'comp.yaml', tmp_path / 'result.json'
     code = main(['identify', str(csv), '--workers', '1', '--json', str(result),
                  '--params-out', str(params)])
