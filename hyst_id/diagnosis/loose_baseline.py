@@ -51,9 +51,9 @@ from hyst_id.diagnosis.select import Data, evaluate, FitResult, polish
 from hyst_id.errors import NoExcitationError
 from hyst_id.identification import identify, IdentifySettings
 from hyst_id.identification.chains import ChainSpec
-from hyst_id.identification.loose_phase import LOOSE_GAIN
+from hyst_id.identification.loose_phase import LOOSE_GAIN, misordered_corners
 from hyst_id.io.recording import Recording
-from hyst_id.models.tk import loop_corners, loop_is_proper
+from hyst_id.models.tk import loop_is_proper
 from hyst_id.signals.noise import floor_percent
 
 __all__ = ['kept_loose_note', 'LOOSE_EVEN', 'LOOSE_FROM', 'LOOSE_NEAR', 'loose_baseline']
@@ -100,8 +100,7 @@ def loose_baseline(rec_train: Recording, spec: ChainSpec, settings: DiagnoseSett
         Why the loop is not proper ('' when ``best`` is kept).
     """
     model = best.model
-    if (not settings.loose_loops or not model.spec.proper or model.spec.family.id != 'tk'
-            or model.mechanisms):
+    if not settings.loose_loops or not model.spec.proper or model.spec.family.id != 'tk':
         return best, ''
     floor = floor_percent(data.y[:data.n_train], data.noise_std)
     floor_h = floor_percent(data.y[data.n_train:], data.noise_std)
@@ -146,14 +145,11 @@ def kept_loose_note(final: FitResult, note: str) -> tuple[bool, str]:
 
 def _note(h: np.ndarray, ctx: Context, proper_ratio: float, loose_ratio: float) -> str:
     """What the loop outside the proper set is, in the recording's command units."""
-    k, b = ctx.command_scale
-    corners = {name: k * vu[0] + b for name, vu in loop_corners(h).items()}
-    out = [f'{a} {corners[a]:.4g} > {c} {corners[c]:.4g}'
-           for a, c in (('A', 'B'), ('D', 'C'), ('A', 'D'), ('B', 'C')) if corners[a] > corners[c]]
+    out = misordered_corners(h, tuple(ctx.command_scale))
     return (f"the chain's loop is not a proper one: the best proper loop fits the training "
             f'part at {proper_ratio:.2f} x its noise floor, one whose corners are out of order '
             f"(the paper's constraints admit it) at {loose_ratio:.2f} x (command at the "
-            f'corners: {", ".join(out)}; A, D: the left line at the bottom and top lines, B, '
+            f'corners: {out}; A, D: the left line at the bottom and top lines, B, '
             "C: the right line), and the diagnosis runs over such loops. The paper's step "
             'rule makes its output jump at reversals between those corners, as another '
             'simulator of its equations may, or an actuator that snaps; H^-1 is no exact '

@@ -44,7 +44,7 @@ from hyst_id.identification.chains import ChainSpec
 from hyst_id.identification.result import Identification, IdentifySettings
 from hyst_id.models.tk import loop_corners
 
-__all__ = ['improper_words', 'LOOSE_GAIN', 'LOOSE_WITHIN', 'loose_retry']
+__all__ = ['improper_words', 'LOOSE_GAIN', 'LOOSE_WITHIN', 'loose_retry', 'misordered_corners']
 
 #: The loose search runs only when the proper fit ends within this multiple of the floor:
 #: further off, the misfit is physics the chain lacks (the shared real recordings end at
@@ -94,17 +94,26 @@ def loose_retry(ident: Identification, spec: ChainSpec, settings: IdentifySettin
     return loose
 
 
+def misordered_corners(h, command_scale: tuple[float, float] = (1.0, 0.0)) -> str:
+    """The corner pairs of loop ``h`` that are out of a proper loop's order, in words.
+
+    ``command_scale`` ``(k, b)`` maps the loop's command to the recording's (``k v + b``).
+    """
+    k, b = command_scale
+    corners = {name: k * vu[0] + b for name, vu in loop_corners(h).items()}
+    return ', '.join(f'{p} {corners[p]:.4g} > {q} {corners[q]:.4g}'
+                     for p, q in (('A', 'B'), ('D', 'C'), ('A', 'D'), ('B', 'C'))
+                     if corners[p] > corners[q])
+
+
 def improper_words(ident: Identification, proper_ratio: float) -> str:
     """What a loop outside the proper set means, or '' for a proper one."""
     if ident.proper:
         return ''
-    h = [ident.params[n] for n in ident.names[:8]]
-    corners = {k: v[0] for k, v in loop_corners(h).items()}
-    out = [f'{a} {corners[a]:.4g} > {b} {corners[b]:.4g}'
-           for a, b in (('A', 'B'), ('D', 'C'), ('A', 'D'), ('B', 'C')) if corners[a] > corners[b]]
+    out = misordered_corners([ident.params[n] for n in ident.names[:8]])
     return (f'the loop that fits is not a proper one: no proper loop came below '
             f"{proper_ratio:.2f} x the noise floor, and the paper's constraints admit loops "
-            f'whose corners are out of order (command at the corners: {", ".join(out)}; '
+            f'whose corners are out of order (command at the corners: {out}; '
             'A, D: the left line at the bottom and top lines, B, C: the right line). The '
             "paper's step rule makes such a loop's output jump at reversals between those "
             'corners, as another simulator of its equations may, or an actuator that snaps. '
