@@ -164,15 +164,21 @@ def print_diagnoses(rows: list[dict]) -> None:
               f'{"proper" if r["true_proper"] else "improper":9s}  {r["verdict"]:15s}  '
               f'{"+".join(r["blocks"]) or "-":24s}  {r["final"]:13.2f}  '
               f'{"proper" if r["kept_proper"] else "improper":9s}  {r["seconds"]:7.0f}')
-    for truth in (True, False):
-        mine = [r for r in rows if r['true_proper'] == truth]
-        if mine:
-            finals = sorted(r['final'] for r in mine)
-            print(f'{"proper" if truth else "improper"} truths: {len(mine)}; false claims '
-                  f'{sum(bool(r["blocks"]) for r in mine)}; verdict none '
-                  f'{sum(r["verdict"] == "none" for r in mine)}; final within 1.2 x the floor '
-                  f'{sum(x <= 1.2 for x in finals)}, median {np.median(finals):.2f}, worst '
-                  f'{finals[-1]:.2f}; kept improper {sum(not r["kept_proper"] for r in mine)}')
+    for label, mine in by_truth(rows):
+        finals = sorted(r['final'] for r in mine)
+        print(f'{label} truths: {len(mine)}; false claims '
+              f'{sum(bool(r["blocks"]) for r in mine)}; verdict none '
+              f'{sum(r["verdict"] == "none" for r in mine)}; final within 1.2 x the floor '
+              f'{sum(x <= 1.2 for x in finals)}, median {np.median(finals):.2f}, worst '
+              f'{finals[-1]:.2f}; kept improper {sum(not r["kept_proper"] for r in mine)}; '
+              f'{sum(r["seconds"] for r in mine):.0f} s in all')
+
+
+def by_truth(rows: list[dict]) -> list[tuple[str, list[dict]]]:
+    """The rows of proper and of improper truths, each with its label (empty groups left out)."""
+    groups = [(label, [r for r in rows if r['true_proper'] == truth])
+              for label, truth in (('proper', True), ('improper', False))]
+    return [(label, mine) for label, mine in groups if mine]
 
 
 def test_record(job: tuple[int, str, bool]) -> tuple[int, str, float, bool, float, str]:
@@ -237,14 +243,12 @@ def main(argv: list[str] | None = None) -> int:
               f'{"proper" if r["true_proper"] else "improper":9s}  '
               f'{"proper" if r["kept_proper"] else "improper":9s}  {r["over_noise"]:12.3f}  '
               f'{r["over_floor"]:12.3f}  {r["seconds"]:7.0f}')
-    for truth in (True, False):
-        mine = [r for r in rows if r['true_proper'] == truth]
-        if mine:
-            ratios = sorted(r['over_noise'] for r in mine)
-            print(f'{"proper" if truth else "improper"} truths: {len(mine)}; within 1.1 x the '
-                  f'true noise {sum(x <= 1.1 for x in ratios)}, within 1.5 x '
-                  f'{sum(x <= 1.5 for x in ratios)}; median {np.median(ratios):.3f}, worst '
-                  f'{ratios[-1]:.3f}; kept improper {sum(not r["kept_proper"] for r in mine)}')
+    for label, mine in by_truth(rows):
+        ratios = sorted(r['over_noise'] for r in mine)
+        print(f'{label} truths: {len(mine)}; within 1.1 x the true noise '
+              f'{sum(x <= 1.1 for x in ratios)}, within 1.5 x {sum(x <= 1.5 for x in ratios)}; '
+              f'median {np.median(ratios):.3f}, worst {ratios[-1]:.3f}; kept improper '
+              f'{sum(not r["kept_proper"] for r in mine)}')
     return 0
 
 
