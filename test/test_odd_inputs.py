@@ -117,7 +117,7 @@ def test_a_measurement_that_does_not_follow_the_command_is_not_clean(tmp_path, c
 
 
 def test_a_large_offset_is_not_called_frozen():
-    """Repeats judged against the spread: 0.48 of the samples 'held' at 1e8 before, 0.02 now.
+    """Repeats judged against the spread: at 1e8 about half the samples were 'held' before.
 
     At 1e8 the tolerance's floor (``REPEAT_FLOOR`` of the largest value, above the
     round-off probe's perturbation) is 1e-3 against noise steps of 0.014.
