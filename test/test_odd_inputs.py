@@ -141,3 +141,24 @@ def test_a_measurement_of_one_outlier_says_what_it_is():
     y[200] = 1.0
     with pytest.raises(ConfigError, match='hold one value'):
         domains_from_data(Recording(t, u, y, 'position'))
+
+
+def test_complex_arrays_are_refused_in_words():
+    from hyst_id.io.recording import validate_recording
+    t, u, y = _sine()
+    with pytest.raises(RecordingError, match='measurement is complex'):
+        validate_recording(Recording(t, u, y + 1e-3j, 'position'))
+
+
+@pytest.mark.parametrize('encoding, said', [
+    ('utf-8', None), ('latin-1', 'Latin-1'), ('utf-16', 'UTF-16')])
+def test_a_csv_in_latin_1_or_utf_16_is_read_as_in_utf_8(tmp_path, encoding, said):
+    from hyst_id.io.csv_reader import read_csv
+    t, u, y = _sine()
+    rows = [f'{float(a)!r},{float(b)!r},{float(c)!r}' for a, b, c in zip(t, u, y)]
+    path = tmp_path / f'{encoding}.csv'
+    path.write_bytes('\n'.join(['t [s],valve [mA],position [\u00b5m]'] + rows).encode(encoding))
+    rec = read_csv(path, 'position', columns=(0, 1, 2))
+    np.testing.assert_array_equal(rec.measurement, y)
+    assert rec.measurement_unit == '\u00b5m'
+    assert (said in rec.notes[0]) if said else 'read as' not in rec.notes[0]

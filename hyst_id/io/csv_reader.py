@@ -120,6 +120,20 @@ def _unit_of(cell: str) -> str:
     return cell.strip().strip('[]()').strip()
 
 
+def _decoded(raw: bytes) -> tuple[str, str]:
+    """A CSV file's text and its encoding: UTF-8, UTF-16 with its BOM, else Latin-1.
+
+    Spreadsheets save "Unicode text" as UTF-16 and older tools write Latin-1
+    (a ``µm`` unit in the header); the numbers are ASCII in all three.
+    """
+    if raw[:2] in (b'\xff\xfe', b'\xfe\xff'):
+        return raw.decode('utf-16'), 'UTF-16'
+    try:
+        return raw.decode('utf-8-sig'), 'utf-8'
+    except UnicodeDecodeError:
+        return raw.decode('latin-1'), 'Latin-1'
+
+
 def read_csv(path: str | Path, channel: str, *,
              columns: Sequence[str | int] = DEFAULT_COLUMNS, time_scale: float | None = 1.0,
              delimiter: str | None = None, command_unit: str = '',
@@ -177,7 +191,7 @@ def read_csv(path: str | Path, channel: str, *,
             and time_scale > 0):
         raise ConfigError(f'time_scale must be a positive number, got {time_scale!r}')
     try:
-        text = path.read_text(encoding='utf-8-sig')
+        text, encoding = _decoded(path.read_bytes())
     except (OSError, UnicodeDecodeError) as exc:
         raise RecordingError(f'cannot read {path}: {exc}') from None
     lines = [(n, line) for n, line in enumerate(text.splitlines(), 1)
@@ -247,6 +261,8 @@ def read_csv(path: str | Path, channel: str, *,
                                  f'values (first {data[first, j]} at line {rows[first][0]})')
     note = (f'columns: t_s = {labels[0]} x {time_scale:g}, command = {labels[1]}, '
             f'measurement = {labels[2]}')
+    if encoding != 'utf-8':
+        note += f'; read as {encoding} text (not UTF-8)'
     row_units = [unit_row[i] for i in index] if unit_row else ['', '', '']
     if unit_row:
         note += f'; units from the row under the header: {", ".join(row_units)}'

@@ -186,6 +186,9 @@ def validate_recording(rec: Recording, *, min_samples: int = MIN_SAMPLES,
         raise RecordingError(f'unknown channel {rec.channel!r}; expected one of {CHANNELS}')
     arrays = {}
     for name in ('t_s', 'command', 'measurement'):
+        if np.iscomplexobj(getattr(rec, name)):
+            raise RecordingError(f'{name} is complex: give its real values (a measured '
+                                 'signal has no imaginary part to drop silently)')
         try:
             arr = np.ascontiguousarray(np.asarray(getattr(rec, name), dtype=np.float64))
         except (TypeError, ValueError) as exc:
