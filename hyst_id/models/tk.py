@@ -287,9 +287,14 @@ def invert_hysteresis(params: np.ndarray, desired: np.ndarray, v0: float,
 
 @njit(cache=True)
 def _feasible_rows(pop, proper):
-    """Per row: finite and a proper loop with ``c_l < c_r``, or (not ``proper``) the paper's set.
+    """Per row: finite and a proper loop with ``c_l < c_r``, or (not ``proper``) the loose set.
 
-    The paper's set: slopes and ``c_l < c_r``, the corners in any order.
+    The loose set: the paper's slopes, the corners in any order. The paper's
+    ``c_l < c_r`` compares the lines at output 0, which the profiled
+    calibration moves (any output shift is the same chain): in the loose set
+    it would cut the true loop's whole orbit out of a data-derived box when
+    ``m_l != m_r`` (``bench/improper_loops.py`` #16, #19), so only the
+    paper's own frame keeps it (:meth:`TaoKokotovic.paper_frame_rows`).
     """
     ok = np.empty(pop.shape[0], dtype=np.bool_)
     for i in range(pop.shape[0]):
@@ -303,7 +308,7 @@ def _feasible_rows(pop, proper):
         elif proper:
             ok[i] = hysteresis_feasible(p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7])
         else:
-            ok[i] = slopes_admitted(p[0], p[1], p[2], p[3]) and p[4] < p[5]
+            ok[i] = slopes_admitted(p[0], p[1], p[2], p[3])
     return ok
 
 
@@ -396,7 +401,7 @@ class TaoKokotovic(HysteresisFamily):
         return _feasible_rows(np.ascontiguousarray(pop, dtype=np.float64), True)
 
     def loose_rows(self, pop: np.ndarray) -> np.ndarray:
-        """The paper's constraints only, per row: loops whose output jumps are admitted.
+        """The paper's slopes only, per row: loops whose output jumps are admitted.
 
         With the corners out of order (the left line meeting the bottom or the top
         line right of where the right line does) the step rule jumps at some
@@ -410,9 +415,9 @@ class TaoKokotovic(HysteresisFamily):
         return check_hysteresis(params, proper=False)
 
     def paper_frame_rows(self, pop: np.ndarray) -> np.ndarray:
-        """The paper's ``c_t > c_b`` (top above bottom at command 0), per row."""
+        """The paper's ``c_t > c_b`` (at command 0) and ``c_l < c_r`` (at output 0), per row."""
         pop = np.atleast_2d(pop)
-        return pop[:, 6] > pop[:, 7]
+        return (pop[:, 6] > pop[:, 7]) & (pop[:, 4] < pop[:, 5])
 
     def simulate_rows(self, pop: np.ndarray, v: np.ndarray, ok: np.ndarray,
                       out: np.ndarray) -> None:

@@ -37,7 +37,12 @@ from hyst_id.compensation import InverseModel
 from hyst_id.errors import InvalidParametersError
 from hyst_id.identification import identify, IdentifySettings
 from hyst_id.identification.chains import chain_spec
-from hyst_id.identification.loose_phase import LOOSE_GAIN, loose_retry, LOOSE_WITHIN
+from hyst_id.identification.loose_phase import (
+    kept_loose,
+    LOOSE_GAIN,
+    loose_retry,
+    LOOSE_WITHIN,
+)
 from hyst_id.identification.result import Identification
 from hyst_id.models.registry import get_family
 from hyst_id.models.tk import check_hysteresis, loop_corners, loop_is_proper
@@ -59,6 +64,24 @@ def test_the_paper_set_admits_a_loop_the_proper_set_refuses():
     bad = list(H)
     bad[2] = 2.0
     assert not loose.feasible(np.array(bad + list(X[8:]))[None, :])[0]
+
+
+@pytest.mark.parametrize('delta', [-40.0, -8.0, 0.0, 8.0, 40.0])
+def test_the_loose_set_keeps_every_output_shift_of_a_loop(delta):
+    """An output shift is the same chain (profiled calibration); ``c_l < c_r`` is not kept by it.
+
+    ``bench/improper_loops.py`` #16 and #19: with ``m_l != m_r`` the data-derived box
+    held no shift of the true loop with ``c_l < c_r``, and identify stopped at 1.12-1.23 x.
+    """
+    from hyst_id.identification.gauge import affine_map_output
+    x = np.array(X, dtype=float)
+    x[1] = 1.6 * x[0]                       # m_r != m_l: the shift moves c_l, c_r apart
+    shifted = affine_map_output(x, 1.0, delta)
+    loose = replace(chain_spec('position'), proper=False, domain_source='auto')
+    assert loose.feasible(shifted[None, :])[0]
+    # the paper's own frame (its domains) keeps the paper's c_l < c_r
+    paper = replace(loose, domain_source='paper')
+    assert paper.feasible(shifted[None, :])[0] == (shifted[4] < shifted[5])
 
 
 def test_the_package_simulates_such_a_loop_as_the_reference_does():
@@ -129,6 +152,17 @@ def test_a_loose_fit_is_kept_only_when_clearly_better_and_says_so():
     assert same.proper and same.er_percent == 3.0 and same.other_nfev == 7 + 7
 
 
+@pytest.mark.parametrize('proper, loose, kept', [
+    (3.0, 2.39, True),      # below LOOSE_GAIN x the proper fit
+    (3.0, 2.41, False),
+    (1.23, 0.99, True),     # at the floor where the proper fit is 1.1 x above it (#19)
+    (1.23, 1.12, False),    # above the floor (1.1 x): the gain rule alone, not met
+    (1.15, 1.08, False),    # at the floor, but the proper fit less than 1.1 x above it
+])
+def test_a_loose_fit_at_the_floor_is_kept_where_the_proper_one_is_not(proper, loose, kept):
+    assert kept_loose(loose, proper, 1.0, IdentifySettings().global_factor) is kept
+
+
 def test_a_loose_search_that_finds_a_better_proper_loop_reports_it_proper():
     assert loop_is_proper(*PROPER[:8])
 
@@ -144,10 +178,11 @@ def test_the_lines_an_improper_loop_never_reaches_are_still_said():
     assert words and names
 
 
-#: ``python bench/improper_loops.py --test-record 0 1 2 3 4 5``: rms / sigma 0.973-1.144 over
+#: ``python bench/improper_loops.py --test-record 0 1 2 3 4 5``: rms / sigma 0.973-1.014 over
 #: noise seeds 0-5, each unperturbed and under round-off probes 1 and 2 (18 runs, every one
-#: kept improper); the proper search alone ends near 5.5 x on this chain (the bench's #9).
-RATIO_BOUND = 1.3
+#: kept improper; 0.973-1.144 before the loose set dropped the paper's c_l < c_r); the
+#: proper search alone ends near 5.5 x on this chain (the bench's #9).
+RATIO_BOUND = 1.15
 
 
 @pytest.mark.slow
