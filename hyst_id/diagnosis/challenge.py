@@ -67,7 +67,7 @@ __all__ = ['CHALLENGE_FACTOR', 'chain_fit', 'challenge', 'START_SHARE', 'start_e
 START_SHARE = 0.6
 
 #: A baseline within this multiple of the judged held-out floor makes its claims face
-#: :func:`challenge` (the level below which :data:`hyst_id.diagnosis.driver.UNKNOWN_FACTOR`
+#: :func:`challenge` (the level below which :data:`hyst_id.diagnosis.verdict.UNKNOWN_FACTOR`
 #: counts nothing as missing). The blind family's clean claims came at 1.19 and 1.24 x;
 #: its right claims between 1.3 and 1.5 x (#12 creep, #151 friction, #10 creep) face it too.
 CHALLENGE_FACTOR = 1.5

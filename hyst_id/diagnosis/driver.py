@@ -40,8 +40,9 @@
 When the baseline residual is white, independent of the command and at the
 noise floor on held-out data, no mechanism is tested and the verdict is
 ``none``. When mechanisms were tested, none was accepted and the held-out
-error stays above :data:`UNKNOWN_FACTOR` x the noise floor, the verdict is
-``unknown``: something is missing and it is not in the library. Whenever
+error stays above :data:`~hyst_id.diagnosis.verdict.UNKNOWN_FACTOR` x the noise
+floor, the verdict is ``unknown``: something is missing and it is not in the
+library (:mod:`hyst_id.diagnosis.verdict`). Whenever
 that much is left (with or without findings), an empirical block
 (:mod:`hyst_id.diagnosis.empirical`) measures what a model could still gain
 and which features of the command and time carry it.
@@ -55,8 +56,7 @@ from typing import Callable
 import numpy as np
 from threadpoolctl import threadpool_limits
 
-from hyst_id.diagnosis.baseline import whole_record_er
-from hyst_id.diagnosis.blocked_cv import BlockedCV, confirmed, split_record
+from hyst_id.diagnosis.blocked_cv import BlockedCV, split_record
 from hyst_id.diagnosis.challenge import chain_fit, challenge, withdrawn_note
 from hyst_id.diagnosis.control import drop_superseded, equivalent_chain, null_control
 from hyst_id.diagnosis.control import recheck
@@ -74,24 +74,16 @@ from hyst_id.diagnosis.split_notes import level_note, range_note, require_split,
 from hyst_id.diagnosis.start_cut import other_boundary, start_cut
 from hyst_id.diagnosis.ties import alternatives_record, choose, close_calls, hold_calls
 from hyst_id.diagnosis.trial import try_all
+from hyst_id.diagnosis.verdict import decide_verdict, UNKNOWN_FACTOR
 from hyst_id.errors import ConfigError
 from hyst_id.identification.chains import chain_spec, ChainSpec
-from hyst_id.identification.quality import response_warnings
 from hyst_id.io.recording import Recording, roundoff_probe, validate_part, validate_recording
 from hyst_id.signals.artefacts import find_artefacts
 from hyst_id.signals.noise import floor_percent
 from hyst_id.signals.reversals import command_context
 from hyst_id.signals.split import inside_rows, split_index
 
-__all__ = ['UNKNOWN_FACTOR', 'WHOLE_RECORD_FACTOR', 'diagnose', 'finding_from', 'located_where']
-
-#: Held-out %e_r over the noise floor above which what is left counts as missing physics.
-UNKNOWN_FACTOR = 1.5
-
-#: ...unless the chain identified on the whole record is within this multiple of its floor:
-#: then nothing the data can show is missing (blind #60 of bench/blind_family.py: training
-#: 0.98 x, held out 18 x, the whole record 0.99 x; test/diagnosis/test_empirical.py).
-WHOLE_RECORD_FACTOR = 1.2
+__all__ = ['diagnose', 'finding_from', 'located_where']
 
 
 def _info(fit: FitResult, ctx: Context, command: np.ndarray) -> dict:
@@ -361,27 +353,10 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
     extra = {} if current is baseline else {'blocked_cv': blocked.confirm(baseline, current)}
     if withdrawn:
         extra['withdrawn'] = withdrawn
-    held = [f for f in findings if confirmed(f.blocked_cv)]
-    no_response = response_warnings(baseline.er_train_percent, y[:n_train])
-    if held:
-        verdict = held[0].mechanism
-    elif findings:
-        verdict = 'unknown'     # the split accepted blocks that the time blocks do not hold up
-    elif no_response:           # noise, a wrong column: 'none' would read as a clean actuator
-        verdict, extra['no_response'] = 'unknown', no_response[0]
-    elif not rounds and current.er_holdout_percent > UNKNOWN_FACTOR * floor_h:
-        verdict = 'unknown'     # something is missing, and no block was tried (max_mechanisms 0)
-    elif current.er_holdout_percent > UNKNOWN_FACTOR * floor_h:
-        verdict = 'unknown'     # something is missing, and it is none of the library
-        say('the chain on the whole record: is anything missing at all?')
-        whole = whole_record_er(Recording(t, v, y, rec.channel, source=rec.source), spec,
-                                settings)
-        floor_all = floor_percent(y, sigma)
-        extra['whole_record'] = {'er_percent': whole, 'noise_floor_percent': floor_all}
-        if whole <= WHOLE_RECORD_FACTOR * floor_all:
-            verdict = 'none'    # the chain makes every sample: the split did not decide
-    else:
-        verdict = 'none'
+    verdict, decided = decide_verdict(findings, bool(rounds), baseline, current,
+                                      Recording(t, v, y, rec.channel, source=rec.source),
+                                      n_train, spec, settings, sigma, floor_h, say)
+    extra.update(decided)
     proper_loop, kept = kept_loose_note(current, loose_note)
     notes = [kept] * bool(kept) + notes
     return Diagnosis(channel=rec.channel, source=rec.source, mode='model',

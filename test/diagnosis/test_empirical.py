@@ -28,8 +28,8 @@ import pytest
 from reference_sim import backlash, hysteresis
 
 from hyst_id.diagnosis import diagnose
-from hyst_id.diagnosis.driver import WHOLE_RECORD_FACTOR
 from hyst_id.diagnosis.empirical import empirical_block, stlsq
+from hyst_id.diagnosis.verdict import WHOLE_RECORD_FACTOR
 from hyst_id.io.recording import Recording
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / 'bench'))
@@ -117,12 +117,12 @@ def test_a_held_out_miss_the_chain_makes_on_the_whole_record_is_no_physics(monke
 
     Its real whole-record fit (5 x and more: unknown) is asserted above.
     """
-    import hyst_id.diagnosis.driver as driver
+    import hyst_id.diagnosis.verdict as verdict
     from hyst_id.diagnosis.locate import noise_std
     from hyst_id.signals.noise import floor_percent
     rec = _hum_recording(0)
     floor = floor_percent(rec.measurement, noise_std(rec.measurement))
-    monkeypatch.setattr(driver, 'whole_record_er', lambda *a: floor)
+    monkeypatch.setattr(verdict, 'whole_record_er', lambda *a: floor)
     d = diagnose(rec)
     assert not d.findings and d.verdict == 'none'
     assert d.extra['whole_record']['er_percent'] == floor
