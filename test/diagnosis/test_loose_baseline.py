@@ -25,14 +25,15 @@ from __future__ import annotations
 import json
 from types import SimpleNamespace
 
-from improper_chain import improper_csv, improper_recording
+from improper_chain import improper_csv, improper_recording, X
+import numpy as np
 import pytest
 
 from hyst_id.cli import main
 from hyst_id.diagnosis import diagnose, DiagnoseSettings
 from hyst_id.diagnosis import loose_baseline as loose_module
 from hyst_id.diagnosis.export import compensator_set
-from hyst_id.diagnosis.loose_baseline import loose_baseline, LOOSE_FROM
+from hyst_id.diagnosis.loose_baseline import loose_baseline, LOOSE_FROM, LOOSE_NEAR, LOOSE_RETRY
 from hyst_id.diagnosis.mechanisms.base import Context
 from hyst_id.diagnosis.select import Data
 from hyst_id.errors import InvalidParametersError
@@ -115,3 +116,35 @@ def test_the_loose_search_runs_only_when_asked_and_above_the_floor(
     else:
         assert loose_baseline(rec, spec, settings, data, Context('position', rec.t_s, n),
                               best) == (best, '')
+
+
+@pytest.mark.parametrize('quick, wider, retried, kept', [
+    (1.0, None, False, 1.0),        # at the floor: no second search
+    (1.5, 1.0, True, 1.0),          # near it (#22 of the bench: 1.49 x): searched wider
+    (1.5, 1.7, True, None),         # the wider search no better: the quick fit, too far
+    (3.0, None, False, None),       # far off: physics the loop lacks, no second search
+])
+def test_a_quick_loose_fit_near_the_floor_is_searched_again_wider(
+        monkeypatch, quick, wider, retried, kept):
+    rec, sigma = improper_recording(0)
+    n = 1000
+    y = rec.measurement
+    floor = floor_percent(y[:n], sigma)
+    calls = []
+
+    def fit_of(*args, global_runs):
+        calls.append(global_runs)
+        ratio = quick if global_runs == 0 else wider
+        return SimpleNamespace(er_train_percent=ratio * floor, er_holdout_percent=ratio * floor,
+                               p=np.array(X, dtype=float))
+    monkeypatch.setattr(loose_module, '_loose_fit', fit_of)
+    data = Data(t_s=rec.t_s, v=rec.command, y=y, n_train=n, noise_std=sigma)
+    best = _stand_in(5.0 * floor, 5.0 * floor)
+    fit, note = loose_baseline(rec, chain_spec('position'), SETTINGS, data,
+                               Context('position', rec.t_s, n), best)
+    assert calls == ([0, 2] if retried else [0])
+    assert LOOSE_NEAR < LOOSE_RETRY
+    if kept is None:
+        assert fit is best and note == ''
+    else:
+        assert fit.er_train_percent == kept * floor and 'not a proper one' in note
