@@ -135,5 +135,5 @@ def improper_words(ident: Identification, proper_ratio: float) -> str:
             f'whose corners are out of order (command at the corners: {out}; '
             'A, D: the left line at the bottom and top lines, B, C: the right line). The '
             "paper's step rule makes such a loop's output jump at reversals between those "
-            'corners, as another simulator of its equations may, or an actuator that snaps. '
-            'H^-1 is not an exact inverse of it: the compensator refuses this set')
+            'corners (so does an actuator that snaps). H^-1 is not an exact inverse of it: '
+            'the compensator refuses this set')

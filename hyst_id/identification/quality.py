@@ -65,6 +65,7 @@ __all__ = [
     'assess',
     'domain_edge_warnings',
     'explained_share',
+    'fit_follows',
     'fit_warnings',
     'FOLLOWS_SHARE',
     'floor_estimate_warnings',
@@ -145,7 +146,8 @@ def assess(ident: Identification, rec: Recording,
     out += response_warnings(ident.er_percent, rec.measurement)
     out += [w for w in [offset_words(ident.er_percent, rec.measurement,
                                      rec.measurement_unit)] if w]
-    out += orientation_warnings(rec, _sign(ident))
+    out += orientation_warnings(rec, _sign(ident), followed=fit_follows(
+        ident.er_percent, ident.noise_floor_percent))
     out += fit_warnings(ident) + floor_estimate_warnings(ident, rec.n_samples)
     out += domain_edge_warnings(ident, rec, spec)
     unexcited, names = unexcited_warnings(ident, rec)
@@ -190,11 +192,15 @@ def response_warnings(er_percent: float, measurement: np.ndarray) -> list[str]:
             "measurement's own sample-to-sample changes, so a ratio to it means nothing here"]
 
 
-def orientation_warnings(rec: Recording, sign: float = 1.0) -> list[str]:
+def orientation_warnings(rec: Recording, sign: float = 1.0, *,
+                         followed: bool = False) -> list[str]:
     """Warn about loop shapes the model cannot make, in the sign identified.
 
     The model's loop runs counter-clockwise in ``sign * measurement`` and
     its output never moves against the command right after a reversal.
+    ``followed``: the fit is within :data:`FIT_FACTOR` x the noise floor, so the
+    chain does make what the data show (a loop whose output jumps, a ringing
+    sensor): only the output sign is said.
     """
     y = sign * np.asarray(rec.measurement, dtype=float)
     out = []
@@ -202,6 +208,8 @@ def orientation_warnings(rec: Recording, sign: float = 1.0) -> list[str]:
         out.append('output sign -1: the measurement falls as the chain output rises, so the '
                    'parameters describe -measurement (their output-side values in negated '
                    'measurement units)')
+    if followed:
+        return out
     orientation = loop_orientation(rec.command, y)
     if orientation > 0.005:
         out.append(f'the loop runs clockwise (orientation {orientation:+.2f}): the model makes '
@@ -223,6 +231,12 @@ def floor_says_nothing(er_percent: float, floor_percent: float) -> bool:
     noise-free or smoothed record, whose ratio only measures round-off.
     """
     return not er_percent < NOISE_FREE_RATIO * floor_percent
+
+
+def fit_follows(er_percent: float, floor_percent: float) -> bool:
+    """Whether a fit is within :data:`FIT_FACTOR` x a meaningful noise floor."""
+    return bool(floor_percent > 0 and not floor_says_nothing(er_percent, floor_percent)
+                and er_percent <= FIT_FACTOR * floor_percent)
 
 
 def fit_warnings(ident: Identification) -> list[str]:

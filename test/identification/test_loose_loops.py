@@ -43,6 +43,7 @@ from hyst_id.identification.loose_phase import (
     loose_retry,
     LOOSE_WITHIN,
 )
+from hyst_id.identification.quality import fit_follows, orientation_warnings
 from hyst_id.identification.result import Identification
 from hyst_id.models.registry import get_family
 from hyst_id.models.tk import check_hysteresis, loop_corners, loop_is_proper
@@ -211,3 +212,18 @@ def test_the_cli_reports_an_improper_loop_and_writes_no_compensator_file(tmp_pat
     rms = doc['er_percent'] / 100 * float(np.sqrt(np.mean(rec.measurement ** 2)))
     assert rms / sigma < RATIO_BOUND
     assert 'not a proper one' in out.out
+
+
+def test_a_fit_at_the_floor_is_not_told_it_can_only_approximate_the_loop():
+    """The jumps of an improper loop look clockwise to the orientation measure.
+
+    An independent review (stop 65) got "the loop runs clockwise ... can only approximate
+    this one" next to an improper loop that fitted at 0.98 x the noise; a ringing flow
+    sensor at the floor got "cannot follow these transitions" the same way.
+    """
+    rec, _ = improper_recording(0)
+    assert any('clockwise' in w for w in orientation_warnings(rec))
+    assert orientation_warnings(rec, followed=True) == []
+    assert orientation_warnings(rec, -1.0, followed=True)[0].startswith('output sign -1')
+    assert fit_follows(1.05, 1.0) and not fit_follows(2.0, 1.0)
+    assert not fit_follows(1.0, 1e-12)          # a floor of about 0 next to the fit says nothing
