@@ -298,6 +298,7 @@ def run_case(index: int, methods: tuple[str, ...], seeds: int,
         nfev = ident.nfev          # with the global runs that did not improve
         out['identify'] = (ident.er_percent / floor, nfev,
                            time.perf_counter() - t0)
+        out['proper_loop'] = ident.proper       # the loose phase may keep a loop that jumps
         budget = nfev
         # the same chain identify ended with: its box, initial state and sensor hold
         spec = replace(domains_from_data(rec), initial=ident.initial, hold=ident.hold)
@@ -450,8 +451,9 @@ def main(argv: list[str] | None = None) -> int:
                     fh.write(json.dumps(r) + '\n')
             cells = '  '.join(f'{m} {r[m][0]:.3f}' for m in ('identify', 'CMA-ES', 'DE')
                               if m in r)
-            print(f'#{r["index"]:3d} {r["note"]}: {cells} (noise est {r["noise_error"]:+.0%})',
-                  flush=True)
+            kept = '' if r.get('proper_loop', True) else ', an improper loop kept'
+            print(f'#{r["index"]:3d} {r["note"]}: {cells} (noise est {r["noise_error"]:+.0%}'
+                  f'{kept})', flush=True)
     print()
     print(_summary(results, methods))
     return 0
