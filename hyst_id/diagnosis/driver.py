@@ -306,7 +306,8 @@ def _diagnose(recording: Recording, spec: ChainSpec | None, settings: DiagnoseSe
         findings[-1].blocked_cv = blocked.confirm(current, winner.fit)
         current = winner.fit
         loc = relocate(current)
-    notes = (list(rec.notes) + [start_note] * bool(start_note)
+    notes = (list(rec.notes)
+             + [start_note] * bool(start_note)
              + range_note(v_orig, n_train, data.judged_rows.size) + chain_notes)
     if len(findings) > 1:
         current, dropped = drop_superseded(current, [f.mechanism for f in findings], data,

@@ -71,7 +71,8 @@ LOOSE_NEAR = 1.3
 
 #: A quick loose fit between :data:`LOOSE_NEAR` and this multiple of the training floor is
 #: searched again with identify's global phase (two runs): ``bench/improper_loops.py
-#: --diagnose`` #22, a clean improper chain whose quick loose fit stopped at 1.49 x.
+#: --diagnose`` #22, a clean improper chain whose quick loose fit stopped short of
+#: LOOSE_NEAR and that a ``friction`` block then filled.
 LOOSE_RETRY = 2.0
 
 #: ...and when it fits the training part clearly better (``LOOSE_GAIN``), or as well (within
