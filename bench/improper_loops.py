@@ -47,9 +47,12 @@ only, so every claimed block is a false claim): verdict, blocks, final held-out
 unperturbed and under round-off probes 1 and 2 (``HYST_ID_ROUNDOFF_PROBE``:
 another CPU's last bits), and the ratio its tests bound (``rms / sigma``); with
 ``--diagnose``, of ``test/diagnosis/test_loose_baseline.py`` (the final held-out
-%e_r over the floor, and the verdict)::
+%e_r over the floor, and the verdict). ``--far-record SEEDS``: the same with
+the far-off chain of that test (``improper_chain.FAR``, whose proper fit ends
+near 40 x the floor)::
 
     python bench/improper_loops.py --test-record 0 1 2 3 4 5 [--diagnose]
+    python bench/improper_loops.py --far-record 0 1 2 3
 """
 
 from __future__ import annotations
@@ -181,17 +184,18 @@ def by_truth(rows: list[dict]) -> list[tuple[str, list[dict]]]:
     return [(label, mine) for label, mine in groups if mine]
 
 
-def test_record(job: tuple[int, str, bool]) -> tuple[int, str, float, bool, float, str]:
+def test_record(job: tuple[int, str, bool, bool]) -> tuple[int, str, float, bool, float, str]:
     """The test's recording with noise ``seed`` under probe ``probe``: its bounded ratio.
 
     Identify's RMS error over the true noise, or (``diagnose``) the diagnosis's
     final held-out %e_r over its floor; whether the loop kept is proper; the
-    seconds; the diagnosis's verdict and blocks ('' for identify).
+    seconds; the diagnosis's verdict and blocks ('' for identify). ``far``: the
+    far-off chain's recording (``improper_chain.far_recording``) instead.
     """
-    seed, probe, diagnose_it = job
-    from improper_chain import improper_recording as _recording
+    seed, probe, diagnose_it, far = job
+    from improper_chain import far_recording, improper_recording
     os.environ['HYST_ID_ROUNDOFF_PROBE'] = probe
-    rec, sigma = _recording(seed)
+    rec, sigma = (far_recording if far else improper_recording)(seed)
     t0 = time.monotonic()
     if diagnose_it:
         from hyst_id.diagnosis import diagnose, DiagnoseSettings
@@ -214,10 +218,14 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument('--diagnose', action='store_true', help='diagnose instead of identify')
     ap.add_argument('--test-record', type=int, nargs='+', metavar='SEED',
                     help="the tests' recording with these noise seeds, under probes too")
+    ap.add_argument('--far-record', type=int, nargs='+', metavar='SEED',
+                    help="the same with the tests' far-off chain (improper_chain.FAR)")
     args = ap.parse_args(argv)
-    if args.test_record:
+    if args.test_record or args.far_record:
+        far = not args.test_record
+        seeds = args.far_record if far else args.test_record
         with ProcessPoolExecutor(args.workers) as pool:
-            got = list(pool.map(test_record, [(s, pr, args.diagnose) for s in args.test_record
+            got = list(pool.map(test_record, [(s, pr, args.diagnose, far) for s in seeds
                                               for pr in ('', '1', '2')]))
         what = 'final / floor' if args.diagnose else 'rms / sigma'
         print(f'seed  probe  {what:>13s}  kept loop  seconds  verdict')

@@ -43,7 +43,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_output_arguments(parser, 'the full result',
                          'DIR:write loop, residual and convergence figures (PNG) into DIR')
     parser.add_argument('--params-out', metavar='FILE',
-                        help='write a ROS params file for the compensator node')
+                        help='write a ROS params file for the compensator node (of the best '
+                        'proper loop found when the loop kept is not proper)')
     parser.add_argument('--model', default='tk', metavar='tk|smooth|auto',
                         help="H's family: tk (the paper's piecewise-linear loop, default), "
                         'smooth (Prandtl-Ishlinskii, curved branches) or auto (fit both on '
@@ -99,19 +100,32 @@ def run(args: argparse.Namespace) -> int:
     if args.plot:
         for path in plot_identification(ident, rec, args.plot):
             print(f'wrote {path}', file=sys.stderr)
-    if args.params_out and not ident.proper:
-        raise ConfigError(f'{args.params_out} not written: the loop identified is not proper '
-                          '(see the first warning), and the compensator has no exact inverse of '
-                          'it; --proper-loops identifies the best proper loop')
     if args.params_out:
-        from hyst_id.compensation.params_file import command_limits_for, write_compensator_params
-        limits = command_limits_for(rec.command)
-        write_compensator_params(ident, args.params_out, command_limits=limits)
-        said = '' if limits is None else (
-            f' (with min_command {limits[0]:g}, max_command {limits[1]:g}, initial_command '
-            f"{limits[2]:g}: the recording's commands leave the node's default 4-20)")
-        print(f'wrote {args.params_out}{said}', file=sys.stderr)
+        _write_params(ident, rec, args.params_out)
     return 0
+
+
+def _write_params(ident, rec, path: str) -> None:
+    """The compensator's params file: of the loop kept, or of the best proper one."""
+    from hyst_id.compensation.params_file import command_limits_for, write_compensator_params
+    written, why = ident, ''
+    if not ident.proper:
+        if ident.proper_alternative is None:
+            raise ConfigError(f'{path} not written: the loop identified is not proper (see '
+                              'the first warning), and the compensator has no exact inverse '
+                              'of it; --proper-loops identifies the best proper loop')
+        written = ident.proper_alternative
+        floor = written.noise_floor_percent
+        times = f', {written.er_percent / floor:.2f} x the noise floor' if floor > 0 else ''
+        why = (f' with the best proper loop found (%e_r {written.er_percent:.4g}{times}; the '
+               f'loop kept, {ident.er_percent:.4g}, is not proper, and the compensator has no '
+               'exact inverse of it: see the first warning)')
+    limits = command_limits_for(rec.command)
+    write_compensator_params(written, path, command_limits=limits)
+    said = '' if limits is None else (
+        f' (with min_command {limits[0]:g}, max_command {limits[1]:g}, initial_command '
+        f"{limits[2]:g}: the recording's commands leave the node's default 4-20)")
+    print(f'wrote {path}{why}{said}', file=sys.stderr)
 
 
 def _choose(args: argparse.Namespace, rec, settings):

@@ -132,8 +132,9 @@ class IdentifySettings:
         (the paper fits the whole run) and in a diagnosis's baseline (judged
         on the whole record; its blind-family figures were measured without).
     loose_loops : bool
-        With refinement on, when every proper search ends between ``global_factor``
-        and :data:`~hyst_id.identification.loose_phase.LOOSE_WITHIN` x the floor:
+        With refinement on, when every proper search ends above ``global_factor``
+        x the floor (beyond :data:`~hyst_id.identification.loose_phase.LOOSE_WITHIN`
+        x only when a quick loose fit comes within it):
         search the paper's constraint set too, loops whose output jumps at some
         reversals (:mod:`hyst_id.identification.loose_phase`), and keep such a loop
         only when it fits clearly better. Off in the paper's experiment, a
@@ -234,6 +235,9 @@ class Identification:
     other_nfev : int
         Evaluations of global-phase runs and basin hopping that did not improve
         (not in ``runs``); :attr:`nfev` counts them with the runs'.
+    proper_alternative : Identification or None
+        When the loop kept is not :attr:`proper`: the best proper loop the proper
+        search found before (what a compensator can invert); else None.
     """
 
     channel: str
@@ -257,6 +261,7 @@ class Identification:
     initial: str = 'rising'
     hold: str = 'before'
     other_nfev: int = 0
+    proper_alternative: Identification | None = field(default=None, repr=False)
 
     @property
     def proper(self) -> bool:
@@ -315,4 +320,8 @@ class Identification:
             'poorly_determined': {k: (v if np.isfinite(v) else None)
                                   for k, v in self.poorly_determined.items()},
             'runs': runs,
+            'proper_alternative': None if self.proper_alternative is None else {
+                'params': self.proper_alternative.params,
+                'output_sign': self.proper_alternative.output_sign,
+                'er_percent': self.proper_alternative.er_percent},
         }
