@@ -278,10 +278,18 @@ def format_diagnosis(d: Any) -> str:
             lines.append(f'verdict: unknown - the model misses something ({ratio:.2f} x the '
                          'noise floor on held-out data) and no block of the library was tried '
                          '(max_mechanisms 0).')
-        elif not d.rounds:
+        elif not d.rounds and d.localization.white and d.localization.independent:
             lines.append('verdict: none - the baseline residual is white, independent of the '
                          'command and at the noise floor on held-out data: this record shows no '
                          'physics that the model leaves out.')
+        elif not d.rounds:
+            ratio = over(d.final.er_holdout_percent, d.noise_floor_percent)
+            lines.append(f'verdict: none - the baseline is within {ratio:.2f} x the noise floor '
+                         'on held-out data, where no block is tried; its residual is '
+                         + ('white' if d.localization.white else 'not white')
+                         + (', independent of the command' if d.localization.independent
+                            else ', related to the command')
+                         + ' (above): what is left is small, and may still be structured.')
         elif d.verdict == 'unknown':
             ratio = over(d.final.er_holdout_percent, d.noise_floor_percent)
             lines.append('verdict: unknown - the model misses something '

@@ -22,6 +22,7 @@ the rig simulator is ``test_concealed_bags.py``.
 
 from __future__ import annotations
 
+from dataclasses import replace
 import json
 from pathlib import Path
 
@@ -293,6 +294,20 @@ def test_report_and_figure(delay_diagnosis, clean_diagnosis, tmp_path):
     assert path.stat().st_size > 10_000
     small = plot_diagnosis(delay_diagnosis, tmp_path / 'small.png', dpi=72)   # the docs'
     assert 5_000 < small.stat().st_size < path.stat().st_size
+
+
+def test_a_none_without_rounds_says_the_residual_is_white_only_when_it_is(clean_diagnosis):
+    """``max_mechanisms=0`` within the floor: the words follow the residual's checks."""
+    loc = clean_diagnosis.localization
+    for white, independent, said in [(True, True, 'the baseline residual is white'),
+                                     (False, True, 'its residual is not white, independent'),
+                                     (True, False, 'its residual is white, related to the')]:
+        d = replace(clean_diagnosis, rounds=[], findings=[], verdict='none',
+                    localization=replace(loc, white=white, independent=independent))
+        verdict = next(x for x in d.report().splitlines() if x.startswith('verdict:'))
+        assert said in verdict
+        assert ('residual is white, independent of the command and at the noise floor'
+                in verdict) is (white and independent)
 
 
 def test_words_and_axes_name_what_the_file_measured(delay_diagnosis, tmp_path, monkeypatch):
