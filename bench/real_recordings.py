@@ -119,7 +119,7 @@ def run_one(rec, seeds: int, seed: int = 0) -> dict:
         pred = ident.spec().simulate(ident.x, rec.t_s, rec.command)
         budget = ident.nfev
         out['identify'] = {'train': _er(yt, pred[:n_train]), 'holdout': _er(yh, pred[n_train:]),
-                           'nfev': budget, 'wall_s': wall}
+                           'nfev': budget, 'wall_s': wall, 'proper': ident.proper}
         spec = replace(domains_from_data(train), initial=ident.initial, hold=ident.hold)
         t0 = time.perf_counter()
         _, x = cmaes_minimise(spec, train, seed, budget)
@@ -147,6 +147,8 @@ def _table(results: list[dict]) -> str:
         better = 'identify at least as good' if i['holdout'] <= c['holdout'] * 1.0001 else \
             'CMA-ES better'
         verdict = better + ('' if r['can_make'] else '; the chain cannot make this loop')
+        if not i.get('proper', True):
+            verdict += '; identify kept a loop that is not proper'
         lines.append(f"| {r['source']} | {r['n']} ({r['n_train']}) | "
                      f"{r['floor_train']:.3f} / {r['floor_holdout']:.3f} | "
                      f"{i['train']:.3f} | {i['holdout']:.3f} | {c['train']:.3f} | "
