@@ -268,8 +268,9 @@ def _identify(rec: Recording, spec: ChainSpec | None, settings: IdentifySettings
     settings = settings or IdentifySettings()
     spec = spec or domains_from_data(rec)
     ident = _identify_chain(rec, spec, settings, progress, on_generation, should_stop)
-    return loose_retry(ident, spec, settings, lambda loose, plain: _identify_chain(
-        rec, loose, plain, progress, on_generation, should_stop))
+    return loose_retry(ident, spec, settings, lambda loose, plain, quiet: _identify_chain(
+        rec, loose, plain, None if quiet else progress, None if quiet else on_generation,
+        should_stop))
 
 
 def _identify_chain(rec: Recording, spec: ChainSpec, settings: IdentifySettings,

@@ -65,7 +65,7 @@ LOOSE_GAIN = 0.8
 
 
 def loose_retry(ident: Identification, spec: ChainSpec, settings: IdentifySettings,
-                run: Callable[[ChainSpec, IdentifySettings], Identification]
+                run: Callable[[ChainSpec, IdentifySettings, bool], Identification]
                 ) -> Identification:
     """``ident``, or the identification over the paper's wider set when it fits clearly better.
 
@@ -78,7 +78,8 @@ def loose_retry(ident: Identification, spec: ChainSpec, settings: IdentifySettin
     settings : IdentifySettings
         ``loose_loops`` (off: ``ident`` as it is), ``refine``, ``global_factor``.
     run : callable
-        ``run(spec, settings)`` identifies again in another chain spec.
+        ``run(spec, settings, quiet)`` identifies again in another chain spec
+        (``quiet``: without reporting its runs as progress, for the quick look).
 
     Returns
     -------
@@ -97,12 +98,12 @@ def loose_retry(ident: Identification, spec: ChainSpec, settings: IdentifySettin
     if ident.er_percent > LOOSE_WITHIN * floor:
         # far off: physics the chain lacks, unless a quick look at the loose set comes near
         probe = run(loose_spec, replace(loose_settings, seeds=settings.seeds[:2], restarts=0,
-                                        global_runs=0, hops=0))
+                                        global_runs=0, hops=0), True)
         if probe.er_percent > LOOSE_WITHIN * floor:
             ident.other_nfev += probe.nfev
             return ident
         ident.other_nfev += probe.nfev
-    loose = run(loose_spec, loose_settings)
+    loose = run(loose_spec, loose_settings, False)
     if not kept_loose(loose.er_percent, ident.er_percent, floor, settings.global_factor):
         ident.other_nfev += loose.nfev
         return ident

@@ -121,9 +121,10 @@ def _ident(er: float, floor: float = 1.0, params: list | None = None) -> Identif
                           domain_source='auto', settings=IdentifySettings(), other_nfev=7)
 
 
-PROBE = (False, False, 2, 0, 0, 0)  # the loose set, two seeds, no restarts, global phase, hops
+#: the loose set, two seeds, no restarts, global phase or hops, not reported as progress
+PROBE = (False, False, 2, 0, 0, 0, True)
 FULL = (False, False, len(IdentifySettings().seeds), IdentifySettings().restarts,
-        IdentifySettings().global_runs, IdentifySettings().hops)
+        IdentifySettings().global_runs, IdentifySettings().hops, False)
 
 
 @pytest.mark.parametrize('er, probe_er, settings, runs', [
@@ -139,18 +140,20 @@ def test_the_loose_search_runs_only_above_the_floor_and_within_reach(er, probe_e
                                                                      runs):
     calls = []
 
-    def run(spec, plain):
+    def run(spec, plain, quiet):
         calls.append((spec.proper, plain.loose_loops, len(plain.seeds), plain.restarts,
-                      plain.global_runs, plain.hops))
+                      plain.global_runs, plain.hops, quiet))
         return _ident(probe_er if plain.global_runs == 0 else er, params=list(X))
-    loose_retry(_ident(er), chain_spec('position'), settings, run)
+    proper_fit = _ident(er)
+    kept = loose_retry(proper_fit, chain_spec('position'), settings, run)
     assert calls == runs
+    assert kept is proper_fit and kept.other_nfev == 7 + 7 * len(runs)  # every evaluation
 
 
 def test_a_loose_fit_is_kept_only_when_clearly_better_and_says_so():
     proper_fit = _ident(3.0)
 
-    def better(spec, plain):
+    def better(spec, plain, quiet):
         return _ident(1.0, params=list(X))
     kept = loose_retry(proper_fit, chain_spec('position'), IdentifySettings(), better)
     assert not kept.proper and kept.other_nfev == 7 + 7
@@ -158,7 +161,7 @@ def test_a_loose_fit_is_kept_only_when_clearly_better_and_says_so():
     assert kept.warnings[0].startswith('the loop that fits is not a proper one')
     assert 'A 7.86 > B 7.35' in kept.warnings[0] and 'compensator refuses' in kept.warnings[0]
 
-    def barely(spec, plain):
+    def barely(spec, plain, quiet):
         return _ident(3.0 * LOOSE_GAIN * 1.01, params=list(X))
     same = loose_retry(_ident(3.0), chain_spec('position'), IdentifySettings(), barely)
     assert same.proper and same.er_percent == 3.0 and same.other_nfev == 7 + 7
@@ -179,7 +182,7 @@ def test_a_loose_fit_at_the_floor_is_kept_where_the_proper_one_is_not(proper, lo
 def test_a_loose_search_that_finds_a_better_proper_loop_reports_it_proper():
     assert loop_is_proper(*PROPER[:8])
 
-    def found_proper(spec, plain):
+    def found_proper(spec, plain, quiet):
         return _ident(1.0, params=PROPER)
     kept = loose_retry(_ident(3.0), chain_spec('position'), IdentifySettings(), found_proper)
     assert kept.proper and kept.er_percent == 1.0 and not kept.warnings
