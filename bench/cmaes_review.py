@@ -32,7 +32,9 @@ default, is the reviewer's draw) and prints one table; ``--no-cma`` skips the
 CMA-ES (its column then reads ``nan``); ``--diagnose`` also runs ``diagnose``
 with its defaults on each (every recording is the bare chain, so any mechanism
 claimed is a false claim) and prints the verdict, the final held-out %e_r over
-the diagnosis's own floor and the seconds (docs/reliability.md section 15)::
+the diagnosis's own floor, its baseline's training %e_r over the training floor
+and the seconds (docs/reliability.md section 15); ``--indices`` runs only those
+recordings of each draw::
 
     python bench/cmaes_review.py --seeds 1 2 3 4 --no-cma --diagnose --workers 1
 """
@@ -80,6 +82,7 @@ def one(job: tuple[int, int, int, bool, bool]) -> dict:
         d = diagnose(rec)
         row.update(verdict=d.verdict, findings=[f.mechanism for f in d.findings],
                    final=d.final.er_holdout_percent / d.noise_floor_percent,
+                   base_train=d.baseline.er_train_percent / d.noise_floor_train_percent,
                    diagnose_s=time.monotonic() - t0)
     return row
 
@@ -92,14 +95,17 @@ def main() -> int:
     ap.add_argument('--seeds', type=int, nargs='+', default=[6565], metavar='S')
     ap.add_argument('--no-cma', action='store_true', help='identify only')
     ap.add_argument('--diagnose', action='store_true', help='also run diagnose')
+    ap.add_argument('--indices', type=int, nargs='+', metavar='I',
+                    help='only these recordings of each draw (0: r1 ... 7: r8)')
     args = ap.parse_args()
     jobs = [(seed, i, args.budget, not args.no_cma, args.diagnose)
-            for seed in args.seeds for i in range(len(draw.PLAN))]
+            for seed in args.seeds for i in (args.indices or range(len(draw.PLAN)))]
     with ProcessPoolExecutor(args.workers) as pool:
         rows = list(pool.map(one, jobs))
     print('rec      channel   excitation      n     noise %  true loop  CMA-ES  identify  '
           'kept loop  CMA-ES s  identify s'
-          + ('  verdict (findings)  final x floor  diagnose s' if args.diagnose else ''))
+          + ('  verdict (findings)  final x floor  baseline train x floor  diagnose s'
+             if args.diagnose else ''))
     for r in rows:
         line = (f'{r["name"]:8s} {r["channel"]:9s} {r["excitation"]:14s} {r["n"]:5d}  '
                 f'{r["noise"]:7.2f}  {"proper" if r["true_proper"] else "improper":9s}  '
@@ -108,7 +114,7 @@ def main() -> int:
                 f'{r["identify_s"]:10.0f}')
         if args.diagnose:
             line += (f'  {r["verdict"]} ({", ".join(r["findings"]) or "-"})  '
-                     f'{r["final"]:6.3f}  {r["diagnose_s"]:6.0f}')
+                     f'{r["final"]:6.3f}  {r["base_train"]:6.3f}  {r["diagnose_s"]:6.0f}')
         print(line)
     ratios = np.array([r['identify'] for r in rows])
     if not args.no_cma:
